@@ -1,0 +1,196 @@
+// probeloop: plan -> synth (test generator) -> evaluate -> scene. Thin: every decision is
+// in the libraries; this file parses arguments, prints summaries and writes files.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include "core/atomic_file.hpp"
+#include "core/csv.hpp"
+#include "core/error.hpp"
+#include "evaluate/ingest.hpp"
+#include "evaluate/sphere_campaign.hpp"
+#include "parts/machine.hpp"
+#include "parts/plan_manifest.hpp"
+#include "parts/sphere_artifact.hpp"
+#include "planner/sphere_cycle.hpp"
+#include "report/scene.hpp"
+#include "sim/rigid_campaign.hpp"
+
+using namespace probeloop;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string join(const std::string& dir, const std::string& file) {
+  return (fs::path(dir) / file).string();
+}
+
+void printResolution(const evaluate::Resolution& r, double step_um) {
+  std::printf("Resolution of the location errors for a %s um coordinate step (seed 004 Table 5.4):\n",
+              formatNumber(step_um).c_str());
+  std::printf("  %-10s %16s %16s\n", "error", "Eqs. 5.4-5.10", "least squares");
+  for (int j = 0; j < 7; ++j) {
+    std::string n = geometry::LocationErrors::names()[j];
+    const std::string unit = j < 4 ? "um" : "um/m";
+    n = n.substr(0, n.find('_'));
+    const std::string f = r.formulas ? formatNumber((*r.formulas)[j], 4) + " " + unit : "n/a";
+    std::printf("  %-10s %16s %16s\n", n.c_str(), f.c_str(),
+                (formatNumber(r.least_squares[j], 4) + " " + unit).c_str());
+  }
+}
+
+int cmdPlan(const std::string& artifact_file, const std::string& machine_file,
+            const std::string& out_dir, const std::string& dialect_opt) {
+  const auto artifact = parts::loadSphereArtifact(artifact_file);
+  const auto machine = parts::loadMachine(machine_file);
+  planner::PlanFiles files;
+  const bool linux = dialect_opt == "linuxcnc" || (dialect_opt == "machine" && machine.dialect == parts::Dialect::LinuxCnc);
+  files.program_file = linux ? "sphere_cycle.ngc" : "sphere_cycle.nc";
+  auto plan = planner::planSphereCycle(artifact, machine, files);
+  const auto dialect = linux ? parts::Dialect::LinuxCnc : parts::Dialect::FanucMacroB;
+  plan.manifest.dialect = parts::dialectName(dialect);
+  plan.manifest.programs.front().dialect = plan.manifest.dialect;
+  const std::string program = planner::programText(plan, dialect);
+  writeFileAtomic(join(out_dir, files.program_file), program);
+  writeFileAtomic(join(out_dir, "plan.json"), parts::manifestToJson(plan.manifest));
+
+  const auto& t = plan.cycle_time;
+  std::printf("Planned %d cycles of the sphere cycle for %s (%s dialect)\n", plan.manifest.cycles,
+              machine.name.c_str(), parts::dialectName(dialect));
+  std::printf("  wrote %s and %s\n", join(out_dir, files.program_file).c_str(),
+              join(out_dir, "plan.json").c_str());
+  std::printf("Estimated cycle time %.1f s (seed 004: 95 s incl. two tool changes):\n", t.total());
+  std::printf("  tool changes %6.1f s\n  C indexing   %6.1f s\n  rapids       %6.1f s\n"
+              "  protected    %6.1f s\n  probing      %6.1f s\n",
+              t.tool_change_s, t.c_index_s, t.rapid_s, t.protected_s, t.probing_s);
+  std::printf("  (no acceleration; see docs/sphere-cycle.md for the comparison with 95 s)\n");
+  printResolution(evaluate::locationErrorResolution(plan.manifest, machine.x.resolution_mm),
+                  machine.x.resolution_mm * 1e3);
+  return 0;
+}
+
+int cmdResolution(const std::string& artifact_file, const std::string& machine_file, double step_um) {
+  const auto plan = planner::planSphereCycle(parts::loadSphereArtifact(artifact_file),
+                                             parts::loadMachine(machine_file));
+  printResolution(evaluate::locationErrorResolution(plan.manifest, step_um * 1e-3), step_um);
+  return 0;
+}
+
+int cmdSynth(const std::string& manifest_file, const std::string& truth_file,
+             const std::string& out_dir, std::uint64_t seed) {
+  const auto m = parts::readManifest(manifest_file);
+  const auto truth = sim::loadRigidTruth(truth_file);
+  const auto s = sim::synthesiseSphereCampaign(m, truth, seed);
+  writeFileAtomic(join(out_dir, "sphere_probe.log"), s.linuxcnc_log);
+  writeFileAtomic(join(out_dir, "sphere_probe_dprnt.txt"), s.fanuc_dprnt);
+  writeFileAtomic(join(out_dir, "points.csv"), s.points_csv);
+  writeFileAtomic(join(out_dir, "truth.json"), s.truth_json);
+  std::printf("Synthesised %d cycles x %zu points (seed %llu) into %s: sphere_probe.log (LinuxCNC), "
+              "sphere_probe_dprnt.txt (Fanuc), points.csv, truth.json\n",
+              m.cycles, m.points.size(), static_cast<unsigned long long>(seed), out_dir.c_str());
+  return 0;
+}
+
+int cmdEvaluate(const std::string& points_file, const std::string& manifest_file,
+                const std::string& out_dir, const std::string& format, bool free_radius,
+                const std::string& scene_file, double exaggeration) {
+  const auto m = parts::readManifest(manifest_file);
+  const auto records = evaluate::readProbeRecords(points_file, evaluate::parsePointsFormat(format), m);
+  evaluate::EvaluateOptions opt;
+  opt.known_radius = !free_radius;
+  const auto e = evaluate::evaluateSphereCampaign(m, records, opt);
+  writeFileAtomic(join(out_dir, "errors.csv"), evaluate::errorSeriesCsv(e));
+  writeFileAtomic(join(out_dir, "evaluation.json"), evaluate::evaluationJson(e, m));
+
+  std::printf("Location errors of the C axis relative to cycle %d (least squares; U for k = 2)\n",
+              e.reference_cycle);
+  std::printf("%6s %9s", "cycle", "time_s");
+  for (const auto* n : geometry::LocationErrors::names()) std::printf(" %17s", n);
+  std::printf("\n");
+  for (const auto& c : e.cycles) {
+    std::printf("%6d %9.0f", c.cycle, c.time_s);
+    for (const auto& b : c.budgets)
+      std::printf(" %8.3f +- %5.3f", b.value, b.U);
+    std::printf("\n");
+  }
+  if (e.formulas_applicable) {
+    double worst = 0;
+    for (const auto& c : e.cycles)
+      for (int j = 0; j < 7; ++j)
+        worst = std::max(worst, std::fabs(c.formulas->values()[j] - c.least_squares.values()[j]));
+    std::printf("Seed 004 Eqs. 5.4-5.10 on positions %d,%d,%d,%d agree with least squares to %.1e\n",
+                e.formula_positions[0], e.formula_positions[1], e.formula_positions[2],
+                e.formula_positions[3], worst);
+  }
+  for (const auto& [c, why] : e.incomplete)
+    std::printf("Cycle %d not evaluated: %s\n", c, why.c_str());
+  std::printf("Wrote %s and %s\n", join(out_dir, "errors.csv").c_str(),
+              join(out_dir, "evaluation.json").c_str());
+
+  if (!scene_file.empty()) {
+    std::vector<report::CycleCentres> cc;
+    for (const auto& c : e.cycles) {
+      report::CycleCentres x;
+      x.cycle = c.cycle;
+      for (const auto& s : c.spheres) x.centre_mm.push_back(s.centre_mm());
+      cc.push_back(x);
+    }
+    writeFileAtomic(scene_file, report::campaignSceneGltf(m, cc, e.reference_cycle, exaggeration));
+    std::printf("Wrote %s (error vectors x%s)\n", scene_file.c_str(), formatNumber(exaggeration).c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"probeloop: plan, simulate and evaluate touch-probe cycles for machine-tool metrology"};
+  app.require_subcommand(1);
+
+  std::string artifact, machine, out = ".", dialect = "machine", manifest, truth, points,
+              format = "auto", scene;
+  double step_um = 1.0, exaggeration = 10000.0;
+  std::uint64_t seed = 1;
+  bool free_radius = false;
+
+  auto* plan = app.add_subcommand("plan", "Sphere-artifact probing cycle: G-code + plan manifest");
+  plan->add_option("artifact", artifact, "sphere artifact description (YAML)")->required()->check(CLI::ExistingFile);
+  plan->add_option("--machine", machine, "machine description (YAML)")->required()->check(CLI::ExistingFile);
+  plan->add_option("--out", out, "output folder")->capture_default_str();
+  plan->add_option("--dialect", dialect, "machine (from the machine file), linuxcnc or fanuc")
+      ->check(CLI::IsMember({"machine", "linuxcnc", "fanuc"}))->capture_default_str();
+
+  auto* res = app.add_subcommand("resolution", "Resolution of the location errors (seed 004 Table 5.4)");
+  res->add_option("artifact", artifact, "sphere artifact description (YAML)")->required()->check(CLI::ExistingFile);
+  res->add_option("--machine", machine, "machine description (YAML)")->required()->check(CLI::ExistingFile);
+  res->add_option("--step-um", step_um, "coordinate step, um")->capture_default_str()->check(CLI::PositiveNumber);
+
+  auto* syn = app.add_subcommand("synth", "Test generator: logs of a campaign with known rigid-body C-axis errors");
+  syn->add_option("manifest", manifest, "plan manifest (plan.json)")->required()->check(CLI::ExistingFile);
+  syn->add_option("--truth", truth, "truth description (YAML)")->required()->check(CLI::ExistingFile);
+  syn->add_option("--out", out, "output folder")->capture_default_str();
+  syn->add_option("--seed", seed, "random seed")->capture_default_str();
+
+  auto* ev = app.add_subcommand("evaluate", "Location errors of the C axis from probe logs or points CSV");
+  ev->add_option("points", points, "LinuxCNC log, Fanuc DPRNT output or points CSV")->required()->check(CLI::ExistingFile);
+  ev->add_option("--manifest", manifest, "plan manifest (plan.json)")->required()->check(CLI::ExistingFile);
+  ev->add_option("--out", out, "output folder")->capture_default_str();
+  ev->add_option("--format", format, "auto, linuxcnc, fanuc or csv")->capture_default_str();
+  ev->add_flag("--free-radius", free_radius, "sphere centres from the free-radius fit (default: known radius)");
+  ev->add_option("--scene", scene, "also write a glTF scene of the campaign");
+  ev->add_option("--exaggeration", exaggeration, "scale of the error vectors in the scene")->capture_default_str();
+
+  CLI11_PARSE(app, argc, argv);
+  try {
+    if (*plan) return cmdPlan(artifact, machine, out, dialect);
+    if (*res) return cmdResolution(artifact, machine, step_um);
+    if (*syn) return cmdSynth(manifest, truth, out, seed);
+    if (*ev) return cmdEvaluate(points, manifest, out, format, free_radius, scene, exaggeration);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "probeloop: error: %s\n", e.what());
+    return 1;
+  }
+  return 2;
+}

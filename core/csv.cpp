@@ -1,0 +1,99 @@
+#include "core/csv.hpp"
+
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+
+#include "core/error.hpp"
+
+namespace probeloop {
+namespace {
+std::string trim(const std::string& s) {
+  size_t a = 0, b = s.size();
+  while (a < b && std::isspace(static_cast<unsigned char>(s[a]))) ++a;
+  while (b > a && std::isspace(static_cast<unsigned char>(s[b - 1]))) --b;
+  return s.substr(a, b - a);
+}
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : line) {
+    if (c == ',') {
+      out.push_back(trim(cur));
+      cur.clear();
+    } else {
+      cur.push_back(c);
+    }
+  }
+  out.push_back(trim(cur));
+  return out;
+}
+}  // namespace
+
+int CsvTable::column(const std::string& name) const {
+  for (size_t i = 0; i < header.size(); ++i)
+    if (header[i] == name) return static_cast<int>(i);
+  return -1;
+}
+
+double CsvTable::number(const CsvRow& row, int col) const {
+  if (col < 0 || col >= static_cast<int>(row.fields.size()))
+    throw InputError(file, row.line, "missing field '" + header.at(col) + "'");
+  const std::string& f = row.fields[col];
+  const char* begin = f.c_str();
+  char* end = nullptr;
+  const double v = std::strtod(begin, &end);
+  if (f.empty() || end != begin + f.size())
+    throw InputError(file, row.line,
+                     "field '" + header[col] + "': '" + f + "' is not a number");
+  if (!std::isfinite(v))
+    throw InputError(file, row.line, "field '" + header[col] + "': '" + f + "' is not finite");
+  return v;
+}
+
+CsvTable parseCsv(const std::string& text, const std::string& file_name) {
+  CsvTable t;
+  t.file = file_name;
+  std::istringstream in(text);
+  std::string line;
+  int n = 0;
+  while (std::getline(in, line)) {
+    ++n;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::string tl = trim(line);
+    if (tl.empty() || tl[0] == '#') continue;
+    auto fields = split(tl);
+    if (t.header.empty()) {
+      t.header = fields;
+      t.header_line = n;
+      continue;
+    }
+    if (fields.size() != t.header.size())
+      throw InputError(file_name, n,
+                       "expected " + std::to_string(t.header.size()) + " fields (header line " +
+                           std::to_string(t.header_line) + "), found " +
+                           std::to_string(fields.size()));
+    t.rows.push_back({n, std::move(fields)});
+  }
+  if (t.header.empty()) throw InputError(file_name, 0, "no header row");
+  return t;
+}
+
+std::string formatNumber(double v, int decimals) {
+  char buf[64];
+  if (decimals >= 0) {
+    std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+    std::string s(buf);
+    if (s == "-0" || (s.rfind("-0.", 0) == 0 && s.find_first_not_of("-0.") == std::string::npos))
+      s.erase(0, 1);  // no negative zero in outputs
+    return s;
+  }
+  auto [p, ec] = std::to_chars(buf, buf + sizeof buf, v);
+  (void)ec;
+  return std::string(buf, p);
+}
+
+}  // namespace probeloop

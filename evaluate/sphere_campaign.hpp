@@ -1,0 +1,90 @@
+// Evaluation of a sphere-artifact campaign (seed 004 Ch. 5): probe records -> one sphere
+// fit per (cycle, position) -> location errors of every complete cycle relative to the
+// reference cycle, by both estimators, each value with its GUM budget.
+//
+// Contract:
+// - A cycle is complete when every position has >= 4 points; incomplete cycles are listed
+//   with the reason and left out (a partial campaign still evaluates).
+// - The reference is the first complete cycle (cycle 1 when it is complete).
+// - The least-squares estimator uses the positions that are not repeats (the 5th position
+//   of the thesis repeats the 1st and is reported as a repeatability indicator).
+// - Budgets propagate each sphere centre's covariance through the estimator's linear
+//   sensitivities: probe repeatability (type B, normal, sigma = 2-sigma spec / 2) and
+//   coordinate resolution (type B, rectangular, q / sqrt(12)) of every point, in this cycle
+//   and in the reference cycle; the sphere's form error cancels (the same sphere points are
+//   probed in every cycle) and is listed with zero contribution.
+#pragma once
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "evaluate/ingest.hpp"
+#include "geometry/location_errors.hpp"
+#include "geometry/sphere_fit.hpp"
+#include "parts/plan_manifest.hpp"
+#include "uncertainty/budget.hpp"
+
+namespace probeloop::evaluate {
+
+struct EvaluateOptions {
+  bool known_radius = true;  // centre from the known-radius fit (R_sphere + r_tip)
+  double coverage_k = 2.0;
+};
+
+struct SphereMeasurement {
+  int position = 0;
+  int points = 0;
+  geometry::SphereFit known_radius;       // radius fixed to R_sphere + r_tip
+  std::optional<geometry::SphereFit> free_radius;  // absent when not determinable
+  std::string free_radius_note;
+  Eigen::Vector3d centre_mm() const { return known_radius.centre_mm; }
+  Eigen::Matrix3d centre_cov_unscaled() const {
+    return known_radius.covariance_unscaled.topLeftCorner<3, 3>();
+  }
+};
+
+struct RepeatIndicator {
+  int position = 0, repeat_of = 0;
+  Eigen::Vector3d difference_um = Eigen::Vector3d::Zero();  // centre(position) - centre(repeat_of)
+};
+
+struct CycleEvaluation {
+  int cycle = 0;
+  double time_s = 0;  // mean planned (or logged) time of the cycle's points
+  std::vector<SphereMeasurement> spheres;  // manifest order
+  geometry::LocationErrors least_squares;
+  std::optional<geometry::LocationErrors> formulas;  // seed 004 Eqs. 5.4-5.10
+  std::array<uncertainty::Budget, 7> budgets;        // for the least-squares values
+  double model_residual_xy_um = 0, model_residual_z_um = 0;
+  std::vector<RepeatIndicator> repeats;
+};
+
+struct CampaignEvaluation {
+  std::string manifest_file, points_file;
+  int reference_cycle = 0;
+  std::vector<int> ls_positions;          // positions used by least squares
+  std::array<int, 4> formula_positions{};  // position of formula index 1..4, 0 if absent
+  bool formulas_applicable = false;
+  std::vector<CycleEvaluation> cycles;    // complete cycles, ascending
+  std::vector<std::pair<int, std::string>> incomplete;  // cycle, reason
+};
+
+CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& manifest,
+                                          const std::vector<ProbeRecord>& records,
+                                          const EvaluateOptions& options = {});
+
+// Error series CSV (DESIGN.md §3): time_s,cycle,<7 errors>,U_<7 errors>.
+std::string errorSeriesCsv(const CampaignEvaluation& e);
+std::string evaluationJson(const CampaignEvaluation& e, const parts::PlanManifest& m);
+
+// Theoretical resolution of each error (seed 004 L1444, Table 5.4): the largest change of
+// the error when one centre coordinate of the cycle changes by one step, for the formulas
+// (when applicable) and for the least squares.
+struct Resolution {
+  std::optional<std::array<double, 7>> formulas;
+  std::array<double, 7> least_squares{};
+};
+Resolution locationErrorResolution(const parts::PlanManifest& m, double step_mm);
+
+}  // namespace probeloop::evaluate

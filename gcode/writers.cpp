@@ -1,0 +1,176 @@
+#include <cmath>
+#include <sstream>
+
+#include "core/csv.hpp"
+#include "gcode/probe_program.hpp"
+
+namespace probeloop::gcode {
+namespace {
+
+// 4 decimals = 0.1 um, finer than any axis resolution; "-0.0000" never appears.
+std::string n4(double v) { return formatNumber(v, 4); }
+std::string n3(double v) { return formatNumber(v, 3); }
+// A constant inside a Fanuc expression: "#5061-[-139.0000]", never "#5061--139.0000".
+std::string macroConst(double v) { return v < 0 ? "[" + n4(v) + "]" : n4(v); }
+
+template <class... Ts>
+struct Overloaded : Ts... { using Ts::operator()...; };
+template <class... Ts>
+Overloaded(Ts...) -> Overloaded<Ts...>;
+
+std::string axes(const Rapid& r) {
+  std::string s;
+  if (r.x) s += " X" + n4(*r.x);
+  if (r.y) s += " Y" + n4(*r.y);
+  if (r.z) s += " Z" + n4(*r.z);
+  return s;
+}
+
+std::string xyz(double x, double y, double z) {
+  return " X" + n4(x) + " Y" + n4(y) + " Z" + n4(z);
+}
+
+// Comments cannot nest parentheses in either dialect.
+std::string clean(std::string s) {
+  for (auto& c : s) {
+    if (c == '(') c = '[';
+    if (c == ')') c = ']';
+  }
+  return s;
+}
+
+std::string offsetAxes(bool b) { return b ? " X0 Y0 Z0 B0 C0" : " X0 Y0 Z0 C0"; }
+
+const char* wcs(int n) {
+  static const char* names[] = {"G54", "G55", "G56", "G57", "G58", "G59"};
+  return names[n - 1];
+}
+
+// LinuxCNC: O-word labels must be unique per program; count them.
+struct LinuxWriter {
+  std::ostringstream out;
+  int label = 200;
+
+  void op(const Op& o) {
+    std::visit(Overloaded{
+        [&](const Comment& c) { out << "(" << clean(c.text) << ")\n"; },
+        [&](const Rapid& r) { out << "G0" << axes(r) << "\n"; },
+        [&](const RapidMachineZ& r) { out << "G53 G0 Z" << n4(r.z_mm) << "\n"; },
+        [&](const RotateC& r) { out << "G0 C" << n3(r.c_deg) << "\n"; },
+        [&](const ToolChange& t) {
+          out << "T" << t.tool << " M6\n";
+          out << (t.apply_length_offset ? "G43 H" + std::to_string(t.tool) : std::string("G49"))
+              << "\n";
+        },
+        [&](const ProtectedMove& m) {
+          // G38.3: stop on contact without error; contact here is a collision -> abort.
+          const int l = label++;
+          out << "G38.3" << xyz(m.x, m.y, m.z) << " F" << n3(m.feed_mm_per_min) << "\n";
+          out << "o" << l << " if [#5070 EQ 1]\n";
+          out << "  (ABORT,probeloop: unexpected contact during a protected move - check the "
+                 "artifact position)\n";
+          out << "o" << l << " endif\n";
+        },
+        [&](const ProbeMove& m) {
+          // G38.2 raises "probe move finished without contact" itself: the program stops
+          // and no point is logged.
+          out << "G38.2" << xyz(m.x, m.y, m.z) << " F" << n3(m.feed_mm_per_min) << "\n";
+          out << "(LOG,PT #<_pl_cycle> " << m.position << " " << m.point
+              << " #5061 #5062 #5063)\n";
+        },
+        [&](const Dwell& d) { out << "G4 P" << n3(d.seconds) << "\n"; },
+    }, o);
+  }
+};
+
+struct FanucWriter {
+  std::ostringstream out;
+
+  void op(const Op& o) {
+    std::visit(Overloaded{
+        [&](const Comment& c) { out << "(" << upper(clean(c.text)) << ")\n"; },
+        [&](const Rapid& r) { out << "G0" << axes(r) << "\n"; },
+        [&](const RapidMachineZ& r) { out << "G0 G53 Z" << n4(r.z_mm) << "\n"; },
+        [&](const RotateC& r) { out << "G0 C" << n3(r.c_deg) << "\n"; },
+        [&](const ToolChange& t) {
+          out << "T" << t.tool << " M6\n";
+          out << (t.apply_length_offset ? "G43 H" + std::to_string(t.tool) : std::string("G49"))
+              << "\n";
+        },
+        [&](const ProtectedMove& m) {
+          // G31 completes the move when nothing triggers; a skip position short of the
+          // target means contact, i.e. a collision -> alarm.
+          out << "G31" << xyz(m.x, m.y, m.z) << " F" << n3(m.feed_mm_per_min) << "\n";
+          out << "IF [[ABS[#5061-" << macroConst(m.x) << "]+ABS[#5062-" << macroConst(m.y)
+              << "]+ABS[#5063-" << macroConst(m.z) << "]] GT 0.0005] THEN #3000=2 (UNEXPECTED CONTACT)\n";
+        },
+        [&](const ProbeMove& m) {
+          // Fanuc G31 completes the move without a trigger: a skip position at the target
+          // means no contact -> alarm instead of logging a wrong point.
+          out << "G31" << xyz(m.x, m.y, m.z) << " F" << n3(m.feed_mm_per_min) << "\n";
+          out << "IF [[ABS[#5061-" << macroConst(m.x) << "]+ABS[#5062-" << macroConst(m.y)
+              << "]+ABS[#5063-" << macroConst(m.z) << "]] LT 0.0005] THEN #3000=1 (PROBE DID NOT TRIGGER)\n";
+          out << "DPRNT[PT*#100[40]*" << m.position << "*" << m.point
+              << "*#5061[44]*#5062[44]*#5063[44]]\n";
+        },
+        [&](const Dwell& d) { out << "G4 X" << n3(d.seconds) << "\n"; },
+    }, o);
+  }
+  static std::string upper(std::string s) {
+    for (auto& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    return s;
+  }
+};
+
+}  // namespace
+
+std::string writeLinuxCnc(const ProbeProgram& p) {
+  LinuxWriter w;
+  auto& o = w.out;
+  o << "(" << clean(p.title) << ")\n";
+  for (const auto& h : p.header) o << "(" << clean(h) << ")\n";
+  o << "G21 G90 G17 G40 G49 G80 G94\n";
+  o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_b_axis) << "\n";
+  o << wcs(p.work_offset) << "\n";
+  o << "(LOGOPEN," << p.log_file << ")\n";
+  for (const auto& op : p.before_cycles) w.op(op);
+  o << "#<_pl_cycle> = 1\n";
+  o << "o100 while [#<_pl_cycle> LE " << p.cycles << "]\n";
+  for (const auto& op : p.cycle_body) w.op(op);
+  o << "o101 if [#<_pl_cycle> LT " << p.cycles << "]\n";
+  o << "G4 P" << n3(p.gap_s) << "\n";
+  o << "o101 endif\n";
+  o << "#<_pl_cycle> = [#<_pl_cycle> + 1]\n";
+  o << "o100 endwhile\n";
+  for (const auto& op : p.after_cycles) w.op(op);
+  o << "(LOGCLOSE)\n";
+  o << "M2\n";
+  return o.str();
+}
+
+std::string writeFanucMacroB(const ProbeProgram& p, int program_number) {
+  FanucWriter w;
+  auto& o = w.out;
+  o << "%\n";
+  o << "O" << program_number << " (" << FanucWriter::upper(clean(p.title)) << ")\n";
+  for (const auto& h : p.header) o << "(" << FanucWriter::upper(clean(h)) << ")\n";
+  o << "G21 G90 G17 G40 G49 G80 G94\n";
+  o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_b_axis) << "\n";
+  o << wcs(p.work_offset) << "\n";
+  o << "POPEN\n";
+  for (const auto& op : p.before_cycles) w.op(op);
+  o << "#100=1\n";
+  o << "WHILE [#100 LE " << p.cycles << "] DO1\n";
+  for (const auto& op : p.cycle_body) w.op(op);
+  o << "IF [#100 GE " << p.cycles << "] GOTO 10\n";
+  o << "G4 X" << n3(p.gap_s) << "\n";
+  o << "N10 #100=#100+1\n";
+  o << "END1\n";
+  for (const auto& op : p.after_cycles) w.op(op);
+  o << "PCLOS\n";
+  o << "M30\n";
+  o << "%\n";
+  return o.str();
+}
+
+}  // namespace probeloop::gcode

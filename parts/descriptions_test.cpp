@@ -1,0 +1,97 @@
+// The shipped descriptions load, and every kind of bad input names file, line and key.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "core/error.hpp"
+#include "parts/machine.hpp"
+#include "parts/sphere_artifact.hpp"
+
+using namespace probeloop;
+using namespace probeloop::parts;
+
+namespace {
+const std::string src = PROBELOOP_SOURCE_DIR;
+
+std::string writeTemp(const std::string& name, const std::string& text) {
+  const auto p = std::filesystem::temp_directory_path() / ("probeloop_parts_" + name);
+  std::ofstream(p) << text;
+  return p.string();
+}
+
+// Loads a modified copy of the shipped artifact and returns the error message.
+std::string artifactError(const std::string& from, const std::string& to) {
+  std::ifstream in(src + "/parts/sphere_artifact.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  const auto pos = text.find(from);
+  EXPECT_NE(pos, std::string::npos) << from;
+  text.replace(pos, from.size(), to);
+  const auto path = writeTemp("artifact.yaml", text);
+  try {
+    loadSphereArtifact(path);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(SphereArtifact, ShippedDefaultsFollowTheThesis) {
+  const auto a = loadSphereArtifact(src + "/parts/sphere_artifact.yaml");
+  EXPECT_DOUBLE_EQ(a.radius_from_axis_mm, 160.0);
+  EXPECT_EQ(a.c_positions_deg, (std::vector<double>{0, 90, 180, 270, 360}));
+  EXPECT_EQ(a.pointsPerPosition(), 5);
+  EXPECT_DOUBLE_EQ(a.probing_feed_mm_per_min, 200.0);
+  EXPECT_DOUBLE_EQ(a.gap_s, 300.0);
+}
+
+TEST(SphereArtifact, UnknownKeyNamesLineAndAllowedKeys) {
+  const auto m = artifactError("  approach: 3 mm", "  approach: 3 mm\n  aproach: 3 mm");
+  EXPECT_NE(m.find("sphere_artifact.yaml:19: unknown key 'probing.aproach'"), std::string::npos) << m;
+  EXPECT_NE(m.find("allowed here:"), std::string::npos) << m;
+}
+
+TEST(SphereArtifact, MissingKeyIsNamed) {
+  const auto m = artifactError("  feed: 200 mm/min         # seed 004 L2145\n", "");
+  EXPECT_NE(m.find("missing key 'probing.feed'"), std::string::npos) << m;
+}
+
+TEST(SphereArtifact, WrongUnitIsNamedWithLine) {
+  const auto m = artifactError("radius_from_c_axis: 160 mm", "radius_from_c_axis: 160 s");
+  EXPECT_NE(m.find(":10: placement.radius_from_c_axis: unit 's'"), std::string::npos) << m;
+}
+
+TEST(SphereArtifact, CountAndDurationAreExclusive) {
+  const auto m = artifactError("  count: 12", "  count: 12\n  duration: 72 h");
+  EXPECT_NE(m.find("exactly one of"), std::string::npos) << m;
+}
+
+TEST(SphereArtifact, NanIsRejected) {
+  const auto m = artifactError("diameter: 30 mm", "diameter: .nan");
+  EXPECT_NE(m.find("sphere.diameter"), std::string::npos) << m;
+}
+
+TEST(Machine, ShippedMachinesLoad) {
+  const auto m = loadMachine(src + "/parts/machines/nmv5000.yaml");
+  EXPECT_EQ(m.dialect, Dialect::FanucMacroB);
+  EXPECT_DOUBLE_EQ(m.x.max_mm - m.x.min_mm, 730.0);
+  EXPECT_DOUBLE_EQ(m.y.max_mm - m.y.min_mm, 510.0);
+  EXPECT_DOUBLE_EQ(m.z.max_mm - m.z.min_mm, 510.0);
+  EXPECT_DOUBLE_EQ(m.x.resolution_mm, 0.001);
+  EXPECT_TRUE(m.c.positive_is_clockwise);
+  EXPECT_EQ(m.work_offset, 6);
+  const auto l = loadMachine(src + "/parts/machines/linuxcnc_rotary_mill.yaml");
+  EXPECT_EQ(l.dialect, Dialect::LinuxCnc);
+  EXPECT_FALSE(l.b.present);
+}
+
+TEST(Machine, YamlSyntaxErrorHasLine) {
+  const auto p = writeTemp("bad.yaml", "kind: machine\nname: [unclosed\n");
+  try {
+    loadMachine(p);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.yaml:"), std::string::npos) << e.what();
+  }
+}

@@ -1,0 +1,100 @@
+#include "parts/machine.hpp"
+
+#include "core/error.hpp"
+#include "parts/yaml_reader.hpp"
+
+namespace probeloop::parts {
+
+const char* dialectName(Dialect d) { return d == Dialect::LinuxCnc ? "linuxcnc" : "fanuc"; }
+
+namespace {
+
+LinearAxis readLinear(YamlMap m) {
+  LinearAxis a;
+  a.min_mm = m.quantity("min", Dimension::Length);
+  a.max_mm = m.quantity("max", Dimension::Length);
+  a.max_feed_mm_per_min = m.quantity("max_feed", Dimension::Feed);
+  a.resolution_mm = m.quantity("resolution", Dimension::Micrometre) * 1e-3;
+  if (!(a.max_mm > a.min_mm)) m.fail("max", "travel max must exceed min");
+  if (!(a.max_feed_mm_per_min > 0)) m.fail("max_feed", "must be positive");
+  if (!(a.resolution_mm > 0)) m.fail("resolution", "must be positive");
+  m.finish();
+  return a;
+}
+
+RotaryAxis readRotary(YamlMap m, bool with_sense) {
+  RotaryAxis a;
+  a.present = true;
+  a.continuous = m.booleanOr("continuous", false);
+  if (!a.continuous) {
+    a.min_deg = m.quantity("min", Dimension::Angle);
+    a.max_deg = m.quantity("max", Dimension::Angle);
+    if (!(a.max_deg > a.min_deg)) m.fail("max", "travel max must exceed min");
+  }
+  a.max_speed_rpm = m.quantity("max_speed", Dimension::RotSpeed);
+  if (!(a.max_speed_rpm > 0)) m.fail("max_speed", "must be positive");
+  a.resolution_deg = m.quantity("resolution", Dimension::Angle);
+  if (with_sense) {
+    a.positive_is_clockwise =
+        m.choice("positive_rotation", {"clockwise", "counterclockwise"}) == "clockwise";
+  }
+  m.finish();
+  return a;
+}
+
+}  // namespace
+
+Machine loadMachine(const std::string& path) {
+  YamlMap root(loadYamlFile(path), path, "");
+  Machine mc;
+  mc.file = path;
+  if (root.choice("kind", {"machine"}) != "machine") root.fail("kind", "expected 'machine'");
+  mc.name = root.string("name");
+  mc.iso10791_code = root.stringOr("iso10791_code", "");
+  mc.dialect = root.choice("dialect", {"linuxcnc", "fanuc"}) == "linuxcnc" ? Dialect::LinuxCnc
+                                                                          : Dialect::FanucMacroB;
+  YamlMap axes = root.map("axes");
+  mc.x = readLinear(axes.map("X"));
+  mc.y = readLinear(axes.map("Y"));
+  mc.z = readLinear(axes.map("Z"));
+  if (auto b = axes.mapIfPresent("B")) mc.b = readRotary(*b, false);
+  mc.c = readRotary(axes.map("C"), true);
+  axes.finish();
+  mc.rapid_feed_mm_per_min = root.quantity("rapid_feed", Dimension::Feed);
+  if (!(mc.rapid_feed_mm_per_min > 0)) root.fail("rapid_feed", "must be positive");
+
+  YamlMap table = root.map("c_axis");
+  mc.c_axis_centre_mm.x() = table.quantity("centre_x", Dimension::Length);
+  mc.c_axis_centre_mm.y() = table.quantity("centre_y", Dimension::Length);
+  mc.table_surface_z_mm = table.quantity("table_surface_z", Dimension::Length);
+  table.finish();
+
+  const std::string wo = root.choice("work_offset", {"G54", "G55", "G56", "G57", "G58", "G59"});
+  mc.work_offset = wo[2] - '3';  // G54 -> 1 ... G59 -> 6
+
+  YamlMap tc = root.map("tool_change");
+  mc.tool_change.time_s = tc.quantity("time", Dimension::Duration);
+  mc.tool_change.z_mm = tc.quantity("z", Dimension::Length);
+  mc.tool_change.empty_tool = tc.integer("empty_tool");
+  if (mc.tool_change.time_s < 0) tc.fail("time", "must not be negative");
+  if (mc.tool_change.z_mm < mc.z.min_mm || mc.tool_change.z_mm > mc.z.max_mm)
+    tc.fail("z", "tool-change Z is outside the Z travel");
+  tc.finish();
+
+  YamlMap pr = root.map("probe");
+  mc.probe.tool = pr.integer("tool");
+  mc.probe.length_mm = pr.quantity("length", Dimension::Length);
+  mc.probe.tip_diameter_mm = pr.quantity("tip_diameter", Dimension::Length);
+  mc.probe.repeatability_2sigma_um = pr.quantity("repeatability_2sigma", Dimension::Micrometre);
+  if (mc.probe.tool <= 0) pr.fail("tool", "probe tool number must be positive");
+  if (mc.probe.tool == mc.tool_change.empty_tool)
+    pr.fail("tool", "probe tool number equals tool_change.empty_tool");
+  if (!(mc.probe.length_mm > 0)) pr.fail("length", "must be positive");
+  if (!(mc.probe.tip_diameter_mm > 0)) pr.fail("tip_diameter", "must be positive");
+  if (!(mc.probe.repeatability_2sigma_um >= 0)) pr.fail("repeatability_2sigma", "must be >= 0");
+  pr.finish();
+  root.finish();
+  return mc;
+}
+
+}  // namespace probeloop::parts

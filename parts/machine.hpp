@@ -1,0 +1,62 @@
+// Machine description (YAML, kind: machine). Schema: docs/formats.md#machine.
+//
+// Coordinates: machine coordinates in mm. With the probe's length offset active the
+// controlled point is the stylus-tip centre, so "tip coordinates" = machine coordinates of
+// the gauge line minus (0, 0, probe.length). Travel limits apply to the gauge line.
+#pragma once
+#include <Eigen/Dense>
+#include <string>
+
+namespace probeloop::parts {
+
+enum class Dialect { LinuxCnc, FanucMacroB };
+const char* dialectName(Dialect d);  // "linuxcnc", "fanuc"
+
+struct LinearAxis {
+  double min_mm = 0, max_mm = 0;       // travel of the gauge line, machine coordinates
+  double max_feed_mm_per_min = 0;
+  double resolution_mm = 0.001;
+};
+
+struct RotaryAxis {
+  bool present = false;
+  bool continuous = false;              // no travel limit
+  double min_deg = 0, max_deg = 0;
+  double max_speed_rpm = 0;
+  double resolution_deg = 0.001;
+  // Sense in which the table turns for +C, seen from +Z. A workpiece-side C' axis turns the
+  // table clockwise for +C (ISO 841: the workpiece moves opposite to the tool's +C).
+  bool positive_is_clockwise = true;
+};
+
+struct ProbeSpec {
+  int tool = 0;
+  double length_mm = 0;                 // gauge line to stylus-tip centre (tool table)
+  double tip_diameter_mm = 0;
+  double repeatability_2sigma_um = 0;   // manufacturer's unidirectional repeatability (2 sigma)
+};
+
+struct ToolChangeSpec {
+  double time_s = 0;                    // one tool change, chip to chip
+  double z_mm = 0;                      // machine Z of the gauge line for tool changes (G53)
+  int empty_tool = 0;                   // the tool number that empties the spindle
+};
+
+struct Machine {
+  std::string file;
+  std::string name;
+  std::string iso10791_code;
+  Dialect dialect = Dialect::LinuxCnc;
+  LinearAxis x, y, z;
+  RotaryAxis b, c;
+  double rapid_feed_mm_per_min = 0;     // non-probing moves (the thesis: 6000 mm/min)
+  Eigen::Vector2d c_axis_centre_mm = Eigen::Vector2d::Zero();  // X, Y of C in machine coords
+  double table_surface_z_mm = 0;        // machine Z (tip coordinates) of the table surface
+  int work_offset = 6;                  // 1..6 = G54..G59; the program zeroes it
+  ToolChangeSpec tool_change;
+  ProbeSpec probe;
+};
+
+Machine loadMachine(const std::string& path);
+
+}  // namespace probeloop::parts

@@ -1,0 +1,77 @@
+#include "parts/sphere_artifact.hpp"
+
+#include <cmath>
+
+#include "core/error.hpp"
+#include "parts/yaml_reader.hpp"
+
+namespace probeloop::parts {
+
+SphereArtifact loadSphereArtifact(const std::string& path) {
+  YamlMap root(loadYamlFile(path), path, "");
+  SphereArtifact a;
+  a.file = path;
+  root.choice("kind", {"sphere_artifact"});
+
+  YamlMap s = root.map("sphere");
+  a.sphere_diameter_mm = s.quantity("diameter", Dimension::Length);
+  a.sphere_form_error_um = s.quantityOr("form_error", Dimension::Micrometre, 0.0);
+  a.stem_diameter_mm = s.quantity("stem_diameter", Dimension::Length);
+  a.stem_length_mm = s.quantity("stem_length", Dimension::Length);
+  if (!(a.sphere_diameter_mm > 0)) s.fail("diameter", "must be positive");
+  if (!(a.stem_diameter_mm > 0 && a.stem_diameter_mm < a.sphere_diameter_mm))
+    s.fail("stem_diameter", "must be positive and smaller than the sphere diameter");
+  if (!(a.stem_length_mm >= 0)) s.fail("stem_length", "must not be negative");
+  s.finish();
+
+  YamlMap p = root.map("placement");
+  a.radius_from_axis_mm = p.quantity("radius_from_c_axis", Dimension::Length);
+  a.angle_at_c0_deg = p.quantity("angle_at_c0", Dimension::Angle);
+  if (!(a.radius_from_axis_mm > 0)) p.fail("radius_from_c_axis", "must be positive (d/2 > 0)");
+  p.finish();
+
+  a.c_positions_deg = root.quantityList("c_positions", Dimension::Angle);
+  if (a.c_positions_deg.size() < 3)
+    root.fail("c_positions", "at least 3 C positions are needed to separate the location errors");
+
+  YamlMap pr = root.map("probing");
+  a.equator_points = pr.integer("equator_points");
+  a.top_point = pr.boolean("top_point");
+  a.probing_feed_mm_per_min = pr.quantity("feed", Dimension::Feed);
+  a.positioning_feed_mm_per_min = pr.quantity("positioning_feed", Dimension::Feed);
+  a.approach_mm = pr.quantity("approach", Dimension::Length);
+  a.overtravel_mm = pr.quantity("overtravel", Dimension::Length);
+  a.clearance_mm = pr.quantity("clearance_above_sphere", Dimension::Length);
+  if (a.equator_points < 3) pr.fail("equator_points", "need at least 3 equator points");
+  if (a.pointsPerPosition() < 4)
+    pr.fail("equator_points", "a sphere needs >= 4 points (equator points + top point)");
+  if (!a.top_point)
+    pr.fail("top_point",
+            "equator points alone are coplanar; the top point is needed to fix the centre height");
+  if (!(a.probing_feed_mm_per_min > 0)) pr.fail("feed", "must be positive");
+  if (!(a.positioning_feed_mm_per_min > 0)) pr.fail("positioning_feed", "must be positive");
+  if (!(a.approach_mm > 0)) pr.fail("approach", "must be positive");
+  if (!(a.overtravel_mm > 0)) pr.fail("overtravel", "must be positive");
+  if (!(a.clearance_mm > a.approach_mm))
+    pr.fail("clearance_above_sphere", "must exceed the approach distance");
+  pr.finish();
+
+  YamlMap c = root.map("cycles");
+  const bool has_count = c.has("count"), has_duration = c.has("duration");
+  if (has_count == has_duration) c.fail("count", "give exactly one of 'count' or 'duration'");
+  if (has_count) {
+    a.cycle_count = c.integer("count");
+    if (a.cycle_count < 1) c.fail("count", "must be >= 1");
+  } else {
+    a.duration_s = c.quantity("duration", Dimension::Duration);
+    if (!(a.duration_s > 0)) c.fail("duration", "must be positive");
+  }
+  a.gap_s = c.quantity("gap", Dimension::Duration);
+  if (a.gap_s < 0) c.fail("gap", "must not be negative");
+  a.tool_change_each_cycle = c.boolean("tool_change_each_cycle");
+  c.finish();
+  root.finish();
+  return a;
+}
+
+}  // namespace probeloop::parts

@@ -1,0 +1,40 @@
+// Sphere artifact on the rotary table (YAML, kind: sphere_artifact), seed 004 Ch. 5.
+// Schema: docs/formats.md#sphere-artifact. Lengths in mm, angles in degrees.
+#pragma once
+#include <string>
+#include <vector>
+
+namespace probeloop::parts {
+
+struct SphereArtifact {
+  std::string file;
+  double sphere_diameter_mm = 0;
+  double sphere_form_error_um = 0;     // from the sphere's calibration certificate
+  double stem_diameter_mm = 0;
+  double stem_length_mm = 0;           // table surface to the sphere's lowest point
+  double radius_from_axis_mm = 160;    // d/2 (seed 004: 0.16 m)
+  double angle_at_c0_deg = 180;        // sphere angle about C at C = 0, seen from +Z, from +X
+  std::vector<double> c_positions_deg{0, 90, 180, 270, 360};
+  // Probing: `equator_points` lateral points at machine angles 0, 360/n, ... (+X first)
+  // plus the top point; all stylus-tip centres.
+  int equator_points = 4;
+  bool top_point = true;
+  double probing_feed_mm_per_min = 200;
+  double positioning_feed_mm_per_min = 1000;  // protected moves near the artifact
+  double approach_mm = 3;              // start of the probing move before nominal contact
+  double overtravel_mm = 2;            // how far past nominal contact a probe move may go
+  double clearance_mm = 20;            // clearance plane above the sphere top (tip centre)
+  // Campaign.
+  int cycle_count = 0;                 // either a count ...
+  double duration_s = 0;               // ... or a duration (count derived)
+  double gap_s = 300;                  // end of one cycle to start of the next
+  bool tool_change_each_cycle = true;  // probe in and out every cycle (seed 004: 2 ATC)
+
+  double sphereRadius() const { return sphere_diameter_mm / 2; }
+  double centreHeightAboveTable() const { return stem_length_mm + sphereRadius(); }
+  int pointsPerPosition() const { return equator_points + (top_point ? 1 : 0); }
+};
+
+SphereArtifact loadSphereArtifact(const std::string& path);
+
+}  // namespace probeloop::parts

@@ -1,0 +1,165 @@
+#include "parts/yaml_reader.hpp"
+
+#include <fstream>
+#include <stdexcept>
+
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+
+namespace probeloop::parts {
+
+YAML::Node loadYamlFile(const std::string& path) {
+  const std::string text = readFile(path);
+  try {
+    return YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    throw InputError(path, e.mark.line + 1, "YAML syntax: " + e.msg);
+  }
+}
+
+YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string path)
+    : node_(node), file_(std::move(file)), path_(std::move(path)) {
+  if (!node_.IsMap()) {
+    throw InputError(file_, node_.Mark().line + 1,
+                     (path_.empty() ? std::string("document") : path_) + ": expected a mapping");
+  }
+}
+
+int YamlMap::line() const { return node_.Mark().line + 1; }
+
+int YamlMap::line(const std::string& key) const {
+  const YAML::Node n = node_[key];
+  return n ? n.Mark().line + 1 : line();
+}
+
+void YamlMap::fail(const std::string& key, const std::string& message) const {
+  const std::string where = path_.empty() ? key : path_ + "." + key;
+  throw InputError(file_, line(key), where + ": " + message);
+}
+
+bool YamlMap::has(const std::string& key) const { return static_cast<bool>(node_[key]); }
+
+YAML::Node YamlMap::node(const std::string& key) {
+  allowed_.insert(key);
+  const YAML::Node n = node_[key];
+  if (!n) {
+    const std::string where = path_.empty() ? key : path_ + "." + key;
+    throw InputError(file_, line(), "missing key '" + where + "'");
+  }
+  return n;
+}
+
+double YamlMap::quantity(const std::string& key, Dimension dim) {
+  const YAML::Node n = node(key);
+  if (!n.IsScalar()) fail(key, std::string("expected ") + acceptedUnits(dim));
+  try {
+    return parseQuantity(n.Scalar(), dim);
+  } catch (const std::invalid_argument& e) {
+    fail(key, e.what());
+  }
+}
+
+double YamlMap::quantityOr(const std::string& key, Dimension dim, double fallback) {
+  allowed_.insert(key);
+  return has(key) ? quantity(key, dim) : fallback;
+}
+
+std::vector<double> YamlMap::quantityList(const std::string& key, Dimension dim) {
+  const YAML::Node n = node(key);
+  if (!n.IsSequence()) fail(key, std::string("expected a list of values, each ") + acceptedUnits(dim));
+  std::vector<double> out;
+  for (const auto& item : n) {
+    try {
+      if (!item.IsScalar()) throw std::invalid_argument("expected a scalar");
+      out.push_back(parseQuantity(item.Scalar(), dim));
+    } catch (const std::invalid_argument& e) {
+      throw InputError(file_, item.Mark().line + 1,
+                       (path_.empty() ? key : path_ + "." + key) + "[" +
+                           std::to_string(out.size()) + "]: " + e.what());
+    }
+  }
+  return out;
+}
+
+int YamlMap::integer(const std::string& key) {
+  const YAML::Node n = node(key);
+  try {
+    return n.as<int>();
+  } catch (const YAML::Exception&) {
+    fail(key, "expected an integer, found '" + (n.IsScalar() ? n.Scalar() : "non-scalar") + "'");
+  }
+}
+
+int YamlMap::integerOr(const std::string& key, int fallback) {
+  allowed_.insert(key);
+  return has(key) ? integer(key) : fallback;
+}
+
+bool YamlMap::boolean(const std::string& key) {
+  const YAML::Node n = node(key);
+  try {
+    return n.as<bool>();
+  } catch (const YAML::Exception&) {
+    fail(key, "expected true or false");
+  }
+}
+
+bool YamlMap::booleanOr(const std::string& key, bool fallback) {
+  allowed_.insert(key);
+  return has(key) ? boolean(key) : fallback;
+}
+
+std::string YamlMap::string(const std::string& key) {
+  const YAML::Node n = node(key);
+  if (!n.IsScalar()) fail(key, "expected a string");
+  return n.Scalar();
+}
+
+std::string YamlMap::stringOr(const std::string& key, const std::string& fallback) {
+  allowed_.insert(key);
+  return has(key) ? string(key) : fallback;
+}
+
+std::string YamlMap::choice(const std::string& key, const std::vector<std::string>& allowed) {
+  const std::string v = string(key);
+  for (const auto& a : allowed)
+    if (a == v) return v;
+  std::string list;
+  for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+  fail(key, "'" + v + "' is not one of: " + list);
+}
+
+YamlMap YamlMap::map(const std::string& key) {
+  return YamlMap(node(key), file_, path_.empty() ? key : path_ + "." + key);
+}
+
+std::optional<YamlMap> YamlMap::mapIfPresent(const std::string& key) {
+  allowed_.insert(key);
+  if (!has(key)) return std::nullopt;
+  return map(key);
+}
+
+std::vector<YamlMap> YamlMap::mapList(const std::string& key) {
+  const YAML::Node n = node(key);
+  if (!n.IsSequence() || n.size() == 0) fail(key, "expected a non-empty list of mappings");
+  std::vector<YamlMap> out;
+  const std::string base = path_.empty() ? key : path_ + "." + key;
+  for (size_t i = 0; i < n.size(); ++i)
+    out.emplace_back(n[i], file_, base + "[" + std::to_string(i) + "]");
+  return out;
+}
+
+void YamlMap::finish() {
+  for (const auto& kv : node_) {
+    const std::string k = kv.first.as<std::string>();
+    if (!allowed_.count(k)) {
+      std::string list;
+      for (const auto& a : allowed_) list += (list.empty() ? "" : ", ") + a;
+      const std::string where = path_.empty() ? k : path_ + "." + k;
+      throw InputError(file_, kv.first.Mark().line + 1,
+                       "unknown key '" + where + "'; allowed here: " + list);
+    }
+  }
+}
+
+}  // namespace probeloop::parts

@@ -1,0 +1,51 @@
+// Strict reading of YAML mappings. Contract: every accessor either returns a valid value or
+// throws InputError("<file>:<line>: <path.key>: <what was expected>"); finish() throws on
+// the first key that no accessor asked for, naming the keys that are allowed.
+#pragma once
+#include <yaml-cpp/yaml.h>
+
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "core/units.hpp"
+
+namespace probeloop::parts {
+
+YAML::Node loadYamlFile(const std::string& path);  // syntax errors -> InputError with line
+
+class YamlMap {
+ public:
+  YamlMap(const YAML::Node& node, std::string file, std::string path);
+
+  bool has(const std::string& key) const;
+  double quantity(const std::string& key, Dimension dim);
+  double quantityOr(const std::string& key, Dimension dim, double fallback);
+  std::vector<double> quantityList(const std::string& key, Dimension dim);
+  int integer(const std::string& key);
+  int integerOr(const std::string& key, int fallback);
+  bool boolean(const std::string& key);
+  bool booleanOr(const std::string& key, bool fallback);
+  std::string string(const std::string& key);
+  std::string stringOr(const std::string& key, const std::string& fallback);
+  std::string choice(const std::string& key, const std::vector<std::string>& allowed);
+  YamlMap map(const std::string& key);
+  std::optional<YamlMap> mapIfPresent(const std::string& key);
+  std::vector<YamlMap> mapList(const std::string& key);  // a non-empty list of mappings
+  void finish();  // unknown keys -> InputError
+
+  int line() const;                       // 1-based line of this mapping
+  int line(const std::string& key) const;  // 1-based line of a key's value
+  [[noreturn]] void fail(const std::string& key, const std::string& message) const;
+  const std::string& file() const { return file_; }
+
+ private:
+  YAML::Node node(const std::string& key);
+  YAML::Node node_;
+  std::string file_;
+  std::string path_;
+  std::set<std::string> allowed_;
+};
+
+}  // namespace probeloop::parts
