@@ -48,7 +48,7 @@ SphereFit fitSphere(const std::vector<Eigen::Vector3d>& pts, const SphereFitOpti
 
   // Coplanarity: smallest singular value of the centred cloud = RMS distance to the best
   // plane times sqrt(n).
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(q);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(q, Eigen::ComputeThinV);
   const double plane_rms = svd.singularValues()(2) / std::sqrt(static_cast<double>(n));
   if (plane_rms < 1e-7 * std::max(extent, 1.0)) {
     const double max_dev = (q * svd.matrixV().col(2)).cwiseAbs().maxCoeff();

@@ -15,7 +15,9 @@ namespace {
 const std::string src = PROBELOOP_SOURCE_DIR;
 
 std::string writeTemp(const std::string& name, const std::string& text) {
-  const auto p = std::filesystem::temp_directory_path() / ("probeloop_parts_" + name);
+  // One file per test: ctest runs tests of this binary in parallel processes.
+  const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  const auto p = std::filesystem::temp_directory_path() / ("probeloop_" + test + "_" + name);
   std::ofstream(p) << text;
   return p.string();
 }
@@ -48,7 +50,7 @@ TEST(SphereArtifact, ShippedDefaultsFollowTheThesis) {
 
 TEST(SphereArtifact, UnknownKeyNamesLineAndAllowedKeys) {
   const auto m = artifactError("  approach: 3 mm", "  approach: 3 mm\n  aproach: 3 mm");
-  EXPECT_NE(m.find("sphere_artifact.yaml:19: unknown key 'probing.aproach'"), std::string::npos) << m;
+  EXPECT_NE(m.find("artifact.yaml:19: unknown key 'probing.aproach'"), std::string::npos) << m;
   EXPECT_NE(m.find("allowed here:"), std::string::npos) << m;
 }
 
