@@ -39,18 +39,21 @@ int CsvTable::column(const std::string& name) const {
   return -1;
 }
 
+bool parseFiniteNumber(const std::string& text, double& value) {
+  if (text.empty()) return false;
+  char* end = nullptr;
+  value = std::strtod(text.c_str(), &end);
+  return end == text.c_str() + text.size() && std::isfinite(value);
+}
+
 double CsvTable::number(const CsvRow& row, int col) const {
   if (col < 0 || col >= static_cast<int>(row.fields.size()))
     throw InputError(file, row.line, "missing field '" + header.at(col) + "'");
   const std::string& f = row.fields[col];
-  const char* begin = f.c_str();
-  char* end = nullptr;
-  const double v = std::strtod(begin, &end);
-  if (f.empty() || end != begin + f.size())
+  double v = 0;
+  if (!parseFiniteNumber(f, v))
     throw InputError(file, row.line,
-                     "field '" + header[col] + "': '" + f + "' is not a number");
-  if (!std::isfinite(v))
-    throw InputError(file, row.line, "field '" + header[col] + "': '" + f + "' is not finite");
+                     "field '" + header[col] + "': '" + f + "' is not a finite number");
   return v;
 }
 

@@ -22,6 +22,9 @@ struct CsvTable {
   double number(const CsvRow& row, int col) const;
 };
 
+// Parses the whole string as a finite double (no trailing characters, no NaN or inf).
+bool parseFiniteNumber(const std::string& text, double& value);
+
 CsvTable parseCsv(const std::string& text, const std::string& file_name);
 
 // Shortest round-trip decimal of a double ("%.17g" trimmed), for deterministic output.

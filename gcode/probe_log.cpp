@@ -4,20 +4,10 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "core/csv.hpp"
 #include "core/error.hpp"
 
 namespace probeloop::gcode {
-namespace {
-
-bool parseDouble(const std::string& s, double& v) {
-  if (s.empty()) return false;
-  char* end = nullptr;
-  v = std::strtod(s.c_str(), &end);
-  return end == s.c_str() + s.size() && std::isfinite(v);
-}
-
-}  // namespace
-
 std::vector<LoggedProbePoint> parseProbeLog(const std::string& text, const std::string& file) {
   std::vector<LoggedProbePoint> out;
   std::istringstream in(text);
@@ -44,7 +34,7 @@ std::vector<LoggedProbePoint> parseProbeLog(const std::string& text, const std::
     }
     double v[6];
     for (int i = 0; i < 6; ++i) {
-      if (!parseDouble(tok[i + 1], v[i]))
+      if (!parseFiniteNumber(tok[i + 1], v[i]))
         throw InputError(file, n, "field " + std::to_string(i + 2) + " '" + tok[i + 1] +
                                       "' is not a finite number");
     }

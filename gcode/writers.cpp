@@ -46,6 +46,14 @@ const char* wcs(int n) {
   return names[n - 1];
 }
 
+// Lines both dialects write identically.
+std::string rapidLine(const Rapid& r) { return "G0" + axes(r) + "\n"; }
+std::string rotateLine(const RotateC& r) { return "G0 C" + n3(r.c_deg) + "\n"; }
+std::string toolChangeLines(const ToolChange& t) {
+  return "T" + std::to_string(t.tool) + " M6\n" +
+         (t.apply_length_offset ? "G43 H" + std::to_string(t.tool) : std::string("G49")) + "\n";
+}
+
 // LinuxCNC: O-word labels must be unique per program; count them.
 struct LinuxWriter {
   std::ostringstream out;
@@ -54,14 +62,10 @@ struct LinuxWriter {
   void op(const Op& o) {
     std::visit(Overloaded{
         [&](const Comment& c) { out << "(" << clean(c.text) << ")\n"; },
-        [&](const Rapid& r) { out << "G0" << axes(r) << "\n"; },
+        [&](const Rapid& r) { out << rapidLine(r); },
         [&](const RapidMachineZ& r) { out << "G53 G0 Z" << n4(r.z_mm) << "\n"; },
-        [&](const RotateC& r) { out << "G0 C" << n3(r.c_deg) << "\n"; },
-        [&](const ToolChange& t) {
-          out << "T" << t.tool << " M6\n";
-          out << (t.apply_length_offset ? "G43 H" + std::to_string(t.tool) : std::string("G49"))
-              << "\n";
-        },
+        [&](const RotateC& r) { out << rotateLine(r); },
+        [&](const ToolChange& t) { out << toolChangeLines(t); },
         [&](const ProtectedMove& m) {
           // G38.3: stop on contact without error; contact here is a collision -> abort.
           const int l = label++;
@@ -89,14 +93,10 @@ struct FanucWriter {
   void op(const Op& o) {
     std::visit(Overloaded{
         [&](const Comment& c) { out << "(" << upper(clean(c.text)) << ")\n"; },
-        [&](const Rapid& r) { out << "G0" << axes(r) << "\n"; },
+        [&](const Rapid& r) { out << rapidLine(r); },
         [&](const RapidMachineZ& r) { out << "G0 G53 Z" << n4(r.z_mm) << "\n"; },
-        [&](const RotateC& r) { out << "G0 C" << n3(r.c_deg) << "\n"; },
-        [&](const ToolChange& t) {
-          out << "T" << t.tool << " M6\n";
-          out << (t.apply_length_offset ? "G43 H" + std::to_string(t.tool) : std::string("G49"))
-              << "\n";
-        },
+        [&](const RotateC& r) { out << rotateLine(r); },
+        [&](const ToolChange& t) { out << toolChangeLines(t); },
         [&](const ProtectedMove& m) {
           // G31 completes the move when nothing triggers; a skip position short of the
           // target means contact, i.e. a collision -> alarm.
