@@ -83,7 +83,8 @@ std::string evaluationJson(const CampaignEvaluation& e, const parts::PlanManifes
       ordered_json js;
       js["position"] = s.position;
       js["points"] = s.points;
-      js["centre_mm"] = vec(s.known_radius.centre_mm);
+      js["centre_used"] = s.use_free_radius ? "free_radius" : "known_radius";
+      js["centre_mm"] = vec(s.centre_mm());
       js["known_radius_mm"] = s.known_radius.radius_mm;
       js["known_radius_rms_um"] = s.known_radius.rms_mm * 1e3;
       if (s.free_radius) {

@@ -129,8 +129,13 @@ CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& m,
   out.reference_cycle = out.cycles.front().cycle;
   if (!opt.known_radius)
     for (auto& c : out.cycles)
-      for (auto& s : c.spheres)
-        if (s.free_radius) s.known_radius = *s.free_radius;  // centre from the free fit
+      for (auto& s : c.spheres) {
+        if (!s.free_radius)
+          throw InputError(out.points_file, 0, "--free-radius: cycle " + std::to_string(c.cycle) +
+                                                   " position " + std::to_string(s.position) +
+                                                   ": " + s.free_radius_note);
+        s.use_free_radius = true;
+      }
 
   const CycleEvaluation& ref = out.cycles.front();
   const auto ref_centres = centresOf(ref, layout.ls_positions);

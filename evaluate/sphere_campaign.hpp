@@ -38,9 +38,11 @@ struct SphereMeasurement {
   geometry::SphereFit known_radius;       // radius fixed to R_sphere + r_tip
   std::optional<geometry::SphereFit> free_radius;  // absent when not determinable
   std::string free_radius_note;
-  Eigen::Vector3d centre_mm() const { return known_radius.centre_mm; }
+  bool use_free_radius = false;  // --free-radius: centres from the free fit
+  const geometry::SphereFit& used() const { return use_free_radius ? *free_radius : known_radius; }
+  Eigen::Vector3d centre_mm() const { return used().centre_mm; }
   Eigen::Matrix3d centre_cov_unscaled() const {
-    return known_radius.covariance_unscaled.topLeftCorner<3, 3>();
+    return used().covariance_unscaled.topLeftCorner<3, 3>();
   }
 };
 

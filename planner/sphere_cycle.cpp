@@ -36,6 +36,8 @@ class Walker {
     gauge_ = Vector3d(0, 0, m.tool_change.z_mm);  // XY unknown at start: rapids from here
   }
 
+  // Probing moves are timed to their nominal contact, which the op itself does not carry.
+  void setNextContact(const Vector3d& c) { contact_ = c; }
   void run(const gcode::Op& op, const std::string& where) {
     std::visit([&](const auto& o) { step(o, where); }, op);
   }
@@ -98,15 +100,12 @@ class Walker {
   }
   void step(const gcode::Dwell&, const std::string&) {}  // no dwell inside a cycle
 
- public:
-  Vector3d contact_ = Vector3d::Zero();  // nominal contact of the next probe move
-
- private:
   const Machine& m_;
   CycleTime& t_;
   Vector3d gauge_;
   double length_ = 0.0;
   double c_ = 0.0;
+  Vector3d contact_ = Vector3d::Zero();
 };
 
 }  // namespace
@@ -228,7 +227,7 @@ SpherePlan planSphereCycle(const SphereArtifact& a, const Machine& m, const Plan
   // includes both) and check every target.
   Walker w(m, plan.cycle_time);
   for (size_t i = 0; i < timed.size(); ++i) {
-    if (contact_of[i] >= 0) w.contact_ = man.points[contact_of[i]].contact_mm;
+    if (contact_of[i] >= 0) w.setNextContact(man.points[contact_of[i]].contact_mm);
     w.run(timed[i].first, timed[i].second);
     if (contact_of[i] >= 0) man.points[contact_of[i]].time_in_cycle_s = w.time();
   }

@@ -80,6 +80,9 @@ rm -rf "$W/d"
 "$PL" evaluate "$W/d/sphere_probe_dprnt.txt" --format fanuc --manifest "$W/p/plan.json" --out "$W/d/fa" > /dev/null
 "$PL" evaluate "$W/d/points.csv" --manifest "$W/p/plan.json" --out "$W/d/csv" --scene "$W/d/scene.gltf" > /dev/null
 check "noisy campaign recovered within U (k=2)" python3 "$SRC/tests/integration/compare_errors.py" "$W/d/lc/errors.csv" "$W/d/truth.json" 0 0 --within-U
+"$PL" evaluate "$W/d/sphere_probe.log" --free-radius --manifest "$W/p/plan.json" --out "$W/d/free" > /dev/null
+check "free-radius centres also within U" python3 "$SRC/tests/integration/compare_errors.py" "$W/d/free/errors.csv" "$W/d/truth.json" 0 0 --within-U
+check "free-radius evaluation says which fit it used" grep -q '"centre_used": "free_radius"' "$W/d/free/evaluation.json"
 check "LinuxCNC log and Fanuc DPRNT give identical results" cmp "$W/d/lc/errors.csv" "$W/d/fa/errors.csv"
 check "LinuxCNC log and points CSV give identical results" cmp "$W/d/lc/errors.csv" "$W/d/csv/errors.csv"
 check "formulas and least squares agree to 1e-9 um" python3 - "$W/d/lc/evaluation.json" <<'PY'
