@@ -1,0 +1,334 @@
+#include "evaluate/point_cloud.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cctype>
+#include <cstdint>
+#include <cstring>
+#include <sstream>
+
+#include "core/atomic_file.hpp"
+#include "core/csv.hpp"
+#include "core/error.hpp"
+
+namespace probeloop::evaluate {
+namespace {
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+std::string extensionFormat(const std::string& path) {
+  const auto dot = path.find_last_of('.');
+  const std::string ext = dot == std::string::npos ? "" : lower(path.substr(dot + 1));
+  if (ext == "csv") return "csv";
+  if (ext == "ds") return "ds";
+  if (ext == "xyz" || ext == "txt" || ext == "asc") return "xyz";
+  if (ext == "ply") return "ply";
+  throw InputError(path, 0, "cannot tell the point format from the extension '." + ext +
+                                "'; give --format csv|ds|xyz|ply");
+}
+
+// Splits a line on blanks and commas.
+std::vector<std::string> tokens(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : line) {
+    if (std::isspace(static_cast<unsigned char>(c)) || c == ',') {
+      if (!cur.empty()) out.push_back(cur);
+      cur.clear();
+    } else {
+      cur.push_back(c);
+    }
+  }
+  if (!cur.empty()) out.push_back(cur);
+  return out;
+}
+
+Eigen::Vector3d threeNumbers(const std::vector<std::string>& t, const std::string& file, int line) {
+  if (t.size() < 3)
+    throw InputError(file, line, "expected 3 coordinates x y z, found " + std::to_string(t.size()) +
+                                     " field(s)");
+  Eigen::Vector3d p;
+  static const char* names[3] = {"x", "y", "z"};
+  for (int k = 0; k < 3; ++k)
+    if (!parseFiniteNumber(t[static_cast<size_t>(k)], p[k]))
+      throw InputError(file, line, std::string(names[k]) + ": '" + t[static_cast<size_t>(k)] +
+                                       "' is not a finite number");
+  return p;
+}
+
+void readCsv(PointCloud& pc, const std::string& text, const std::string& feature) {
+  const CsvTable t = parseCsv(text, pc.file);
+  auto col = [&](const char* a, const char* b) {
+    const int c = t.column(a);
+    return c >= 0 ? c : t.column(b);
+  };
+  const int cx = col("x_mm", "x"), cy = col("y_mm", "y"), cz = col("z_mm", "z");
+  if (cx < 0 || cy < 0 || cz < 0)
+    throw InputError(pc.file, t.header_line,
+                     "header needs columns x_mm,y_mm,z_mm (or x,y,z); found " +
+                         std::to_string(t.header.size()) + " columns");
+  const int nx = t.column("nx"), ny = t.column("ny"), nz = t.column("nz");
+  const bool has_n = nx >= 0 && ny >= 0 && nz >= 0;
+  if (!has_n && (nx >= 0 || ny >= 0 || nz >= 0))
+    throw InputError(pc.file, t.header_line, "approach direction needs all of nx,ny,nz");
+  const int cf = t.column("feature");
+  if (!feature.empty() && cf < 0)
+    throw InputError(pc.file, t.header_line, "--feature given but the file has no 'feature' column");
+  for (const auto& row : t.rows) {
+    if (!feature.empty() && row.fields[static_cast<size_t>(cf)] != feature) continue;
+    pc.points_mm.emplace_back(t.number(row, cx), t.number(row, cy), t.number(row, cz));
+    pc.source_lines.push_back(row.line);
+    if (has_n) {
+      const Eigen::Vector3d n(t.number(row, nx), t.number(row, ny), t.number(row, nz));
+      if (std::abs(n.norm() - 1.0) > 1e-3)
+        throw InputError(pc.file, row.line, "approach direction nx,ny,nz must be a unit vector (length " +
+                                                formatNumber(n.norm(), 6) + ")");
+      pc.approach.push_back(n);
+    }
+  }
+  if (!feature.empty() && pc.points_mm.empty())
+    throw InputError(pc.file, 0, "no rows with feature '" + feature + "'");
+}
+
+void readDs(PointCloud& pc, const std::string& text) {
+  std::istringstream in(text);
+  std::string line;
+  int n = 0;
+  long expected = -1;
+  while (std::getline(in, line)) {
+    ++n;
+    const auto t = tokens(line);
+    if (t.empty()) continue;
+    if (expected < 0) {
+      double v = 0;
+      if (t.size() != 1 || !parseFiniteNumber(t[0], v) || v < 1 || v != std::floor(v))
+        throw InputError(pc.file, n, "NIST .ds: the first line must be the number of points");
+      expected = static_cast<long>(v);
+      continue;
+    }
+    if (t.size() != 3) throw InputError(pc.file, n, "NIST .ds: expected 'x y z'");
+    pc.points_mm.push_back(threeNumbers(t, pc.file, n));
+    pc.source_lines.push_back(n);
+  }
+  if (expected < 0) throw InputError(pc.file, 0, "NIST .ds: empty file");
+  if (static_cast<long>(pc.points_mm.size()) != expected)
+    throw InputError(pc.file, 1, "NIST .ds: header says " + std::to_string(expected) +
+                                     " points, the file has " + std::to_string(pc.points_mm.size()));
+}
+
+void readXyz(PointCloud& pc, const std::string& text) {
+  std::istringstream in(text);
+  std::string line;
+  int n = 0;
+  while (std::getline(in, line)) {
+    ++n;
+    const auto hash = line.find('#');
+    if (hash != std::string::npos) line.erase(hash);
+    const auto t = tokens(line);
+    if (t.empty()) continue;
+    pc.points_mm.push_back(threeNumbers(t, pc.file, n));
+    pc.source_lines.push_back(n);
+  }
+}
+
+// --- PLY -------------------------------------------------------------------------------
+struct PlyProperty {
+  std::string name, type, count_type;  // count_type non-empty for lists
+};
+struct PlyElement {
+  std::string name;
+  long count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+int plyTypeSize(const std::string& t) {
+  if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+  if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+  if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" || t == "float32")
+    return 4;
+  if (t == "double" || t == "float64") return 8;
+  return 0;
+}
+
+double plyBinary(const unsigned char* p, const std::string& t, bool big) {
+  unsigned char b[8];
+  const int n = plyTypeSize(t);
+  std::memcpy(b, p, static_cast<size_t>(n));
+  if (big != (std::endian::native == std::endian::big)) std::reverse(b, b + n);
+  if (t == "char" || t == "int8") { std::int8_t v; std::memcpy(&v, b, 1); return v; }
+  if (t == "uchar" || t == "uint8") { std::uint8_t v; std::memcpy(&v, b, 1); return v; }
+  if (t == "short" || t == "int16") { std::int16_t v; std::memcpy(&v, b, 2); return v; }
+  if (t == "ushort" || t == "uint16") { std::uint16_t v; std::memcpy(&v, b, 2); return v; }
+  if (t == "int" || t == "int32") { std::int32_t v; std::memcpy(&v, b, 4); return v; }
+  if (t == "uint" || t == "uint32") { std::uint32_t v; std::memcpy(&v, b, 4); return v; }
+  if (t == "float" || t == "float32") { float v; std::memcpy(&v, b, 4); return v; }
+  double v;
+  std::memcpy(&v, b, 8);
+  return v;
+}
+
+void readPly(PointCloud& pc, const std::string& text) {
+  size_t pos = 0;
+  int line_no = 0;
+  auto nextLine = [&]() -> std::string {
+    if (pos >= text.size()) throw InputError(pc.file, line_no, "PLY header ends without 'end_header'");
+    const size_t e = text.find('\n', pos);
+    std::string l = text.substr(pos, e == std::string::npos ? std::string::npos : e - pos);
+    pos = e == std::string::npos ? text.size() : e + 1;
+    ++line_no;
+    if (!l.empty() && l.back() == '\r') l.pop_back();
+    return l;
+  };
+  if (nextLine() != "ply") throw InputError(pc.file, 1, "not a PLY file: first line must be 'ply'");
+  std::string encoding;
+  std::vector<PlyElement> elements;
+  for (;;) {
+    const std::string l = nextLine();
+    const auto t = tokens(l);
+    if (t.empty()) continue;
+    if (t[0] == "end_header") break;
+    if (t[0] == "comment" || t[0] == "obj_info") continue;
+    if (t[0] == "format") {
+      if (t.size() != 3 || (t[1] != "ascii" && t[1] != "binary_little_endian" &&
+                            t[1] != "binary_big_endian"))
+        throw InputError(pc.file, line_no, "PLY format must be ascii, binary_little_endian or "
+                                           "binary_big_endian");
+      encoding = t[1];
+    } else if (t[0] == "element") {
+      double c = 0;
+      if (t.size() != 3 || !parseFiniteNumber(t[2], c) || c < 0)
+        throw InputError(pc.file, line_no, "PLY: expected 'element <name> <count>'");
+      elements.push_back({t[1], static_cast<long>(c), {}});
+    } else if (t[0] == "property") {
+      if (elements.empty()) throw InputError(pc.file, line_no, "PLY: property before any element");
+      PlyProperty p;
+      if (t.size() == 5 && t[1] == "list") {
+        p = {t[4], t[3], t[2]};
+      } else if (t.size() == 3) {
+        p = {t[2], t[1], ""};
+      } else {
+        throw InputError(pc.file, line_no, "PLY: expected 'property <type> <name>'");
+      }
+      if (plyTypeSize(p.type) == 0 || (!p.count_type.empty() && plyTypeSize(p.count_type) == 0))
+        throw InputError(pc.file, line_no, "PLY: unknown property type '" + p.type + "'");
+      elements.back().properties.push_back(p);
+    } else {
+      throw InputError(pc.file, line_no, "PLY: unexpected header line '" + l + "'");
+    }
+  }
+  if (encoding.empty()) throw InputError(pc.file, 0, "PLY: no 'format' line in the header");
+  const bool ascii = encoding == "ascii";
+  const bool big = encoding == "binary_big_endian";
+  const auto vertex_it = std::find_if(elements.begin(), elements.end(),
+                                      [](const PlyElement& e) { return e.name == "vertex"; });
+  if (vertex_it == elements.end()) throw InputError(pc.file, 0, "PLY: no 'vertex' element");
+  int ix = -1, iy = -1, iz = -1;
+  for (size_t k = 0; k < vertex_it->properties.size(); ++k) {
+    const auto& p = vertex_it->properties[k];
+    if (!p.count_type.empty()) continue;
+    if (p.name == "x") ix = static_cast<int>(k);
+    if (p.name == "y") iy = static_cast<int>(k);
+    if (p.name == "z") iz = static_cast<int>(k);
+  }
+  if (ix < 0 || iy < 0 || iz < 0)
+    throw InputError(pc.file, 0, "PLY: the vertex element needs scalar properties x, y and z");
+
+  std::istringstream ain;
+  if (ascii) ain.str(text.substr(pos));
+  for (const auto& el : elements) {
+    const bool is_vertex = &el == &*vertex_it;
+    for (long i = 0; i < el.count; ++i) {
+      Eigen::Vector3d v = Eigen::Vector3d::Zero();
+      if (ascii) {
+        std::string l;
+        do {
+          if (!std::getline(ain, l))
+            throw InputError(pc.file, line_no, "PLY: file ends inside element '" + el.name + "'");
+          ++line_no;
+        } while (tokens(l).empty());
+        const auto t = tokens(l);
+        size_t at = 0;
+        for (size_t k = 0; k < el.properties.size(); ++k) {
+          const auto& p = el.properties[k];
+          double val = 0;
+          auto take = [&]() {
+            if (at >= t.size() || !parseFiniteNumber(t[at], val))
+              throw InputError(pc.file, line_no, "PLY: element '" + el.name + "' property '" +
+                                                     p.name + "': expected a finite number");
+            ++at;
+          };
+          take();
+          if (!p.count_type.empty()) {
+            const long cnt = static_cast<long>(val);
+            for (long j = 0; j < cnt; ++j) take();
+          } else if (is_vertex) {
+            if (static_cast<int>(k) == ix) v.x() = val;
+            if (static_cast<int>(k) == iy) v.y() = val;
+            if (static_cast<int>(k) == iz) v.z() = val;
+          }
+        }
+        if (is_vertex) pc.source_lines.push_back(line_no);
+      } else {
+        for (size_t k = 0; k < el.properties.size(); ++k) {
+          const auto& p = el.properties[k];
+          auto need = [&](size_t bytes) {
+            if (pos + bytes > text.size())
+              throw InputError(pc.file, 0, "PLY: binary data ends inside element '" + el.name +
+                                               "' number " + std::to_string(i + 1));
+          };
+          if (!p.count_type.empty()) {
+            const size_t cs = static_cast<size_t>(plyTypeSize(p.count_type));
+            need(cs);
+            const double cnt = plyBinary(reinterpret_cast<const unsigned char*>(text.data() + pos),
+                                         p.count_type, big);
+            pos += cs;
+            const size_t bytes = static_cast<size_t>(cnt) * static_cast<size_t>(plyTypeSize(p.type));
+            need(bytes);
+            pos += bytes;
+            continue;
+          }
+          const size_t s = static_cast<size_t>(plyTypeSize(p.type));
+          need(s);
+          const double val =
+              plyBinary(reinterpret_cast<const unsigned char*>(text.data() + pos), p.type, big);
+          pos += s;
+          if (is_vertex) {
+            if (static_cast<int>(k) == ix) v.x() = val;
+            if (static_cast<int>(k) == iy) v.y() = val;
+            if (static_cast<int>(k) == iz) v.z() = val;
+          }
+        }
+        if (is_vertex) {
+          if (!v.allFinite())
+            throw InputError(pc.file, 0, "PLY: vertex " + std::to_string(i + 1) + " is not finite");
+          pc.source_lines.push_back(0);
+        }
+      }
+      if (is_vertex) pc.points_mm.push_back(v);
+    }
+  }
+}
+
+}  // namespace
+
+PointCloud readPointCloud(const std::string& path, const std::string& format_in,
+                          const std::string& feature) {
+  PointCloud pc;
+  pc.file = path;
+  pc.format = format_in == "auto" || format_in.empty() ? extensionFormat(path) : format_in;
+  if (!feature.empty() && pc.format != "csv")
+    throw InputError(path, 0, "--feature selects rows of a points CSV; this file is " + pc.format);
+  const std::string text = readFile(path);
+  if (pc.format == "csv") readCsv(pc, text, feature);
+  else if (pc.format == "ds") readDs(pc, text);
+  else if (pc.format == "xyz") readXyz(pc, text);
+  else if (pc.format == "ply") readPly(pc, text);
+  else throw InputError(path, 0, "unknown point format '" + pc.format + "'; expected csv, ds, xyz or ply");
+  if (pc.points_mm.empty()) throw InputError(path, 0, "no points in the file");
+  return pc;
+}
+
+}  // namespace probeloop::evaluate

@@ -1,0 +1,35 @@
+// Reading a point cloud for a single-feature fit (`probeloop fit`): CSV, NIST .ds, XYZ
+// and PLY.
+//
+// Contract:
+// - csv: a header row; coordinates from columns x_mm,y_mm,z_mm (or x,y,z); optional unit
+//   approach directions nx,ny,nz (the canonical points CSV of DESIGN §3 qualifies; its
+//   other columns are ignored, and `feature` selects rows when a feature is asked for).
+// - ds: NIST algorithm-testing format, first line N, then N lines "x y z".
+// - xyz: one point per line, >= 3 numbers separated by blanks or commas, '#' comments;
+//   extra columns are ignored.
+// - ply: ascii, binary_little_endian or binary_big_endian; the vertex element's x, y, z
+//   properties of any scalar type; other elements and properties are skipped.
+// - auto: by extension (.csv, .ds, .xyz/.txt/.asc, .ply).
+// - Every bad line is an InputError with file:line and what was expected; NaN and inf are
+//   refused. An empty cloud is an error.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "geometry/elements.hpp"
+
+namespace probeloop::evaluate {
+
+struct PointCloud {
+  std::string file;
+  std::string format;                  // csv, ds, xyz, ply
+  geometry::Points3 points_mm;
+  geometry::Points3 approach;          // empty unless the file carries nx,ny,nz (csv)
+  std::vector<int> source_lines;       // 1-based line of each point (ply binary: 0)
+};
+
+PointCloud readPointCloud(const std::string& path, const std::string& format = "auto",
+                          const std::string& feature = "");
+
+}  // namespace probeloop::evaluate

@@ -1,0 +1,133 @@
+#include "evaluate/point_cloud.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+#include "core/error.hpp"
+
+using namespace probeloop;
+using namespace probeloop::evaluate;
+namespace fs = std::filesystem;
+
+namespace {
+std::string writeTemp(const std::string& name, const std::string& content) {
+  const fs::path dir = fs::temp_directory_path() / ("probeloop-pc-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path p = dir / name;
+  std::ofstream(p, std::ios::binary) << content;
+  return p.string();
+}
+std::string errorOf(const std::string& path, const std::string& format = "auto") {
+  try {
+    readPointCloud(path, format);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+}  // namespace
+
+TEST(PointCloud, CanonicalCsvWithApproachAndFeatureFilter) {
+  const auto p = writeTemp("a.csv",
+                           "# probe log\n"
+                           "time_s,cycle,c_deg,feature,point,x_mm,y_mm,z_mm,nx,ny,nz\n"
+                           "0,1,0,bore,1,10.5,0,3,1,0,0\n"
+                           "1,1,0,top,1,0,0,8,0,0,-1\n"
+                           "2,1,0,bore,2,0,10.5,3,0,1,0\n");
+  const auto pc = readPointCloud(p, "auto", "bore");
+  ASSERT_EQ(pc.points_mm.size(), 2u);
+  EXPECT_EQ(pc.format, "csv");
+  EXPECT_EQ(pc.points_mm[1], Eigen::Vector3d(0, 10.5, 3));
+  EXPECT_EQ(pc.approach[1], Eigen::Vector3d(0, 1, 0));
+  EXPECT_EQ(pc.source_lines[1], 5);
+  EXPECT_EQ(readPointCloud(p).points_mm.size(), 3u);
+}
+
+TEST(PointCloud, CsvErrorsNameFileLineAndField) {
+  const auto p = writeTemp("b.csv", "x,y,z\n1,2,3\n1,nan,3\n");
+  EXPECT_NE(errorOf(p).find("b.csv:3: field 'y'"), std::string::npos) << errorOf(p);
+  const auto q = writeTemp("c.csv", "a,b,c\n1,2,3\n");
+  EXPECT_NE(errorOf(q).find("x_mm,y_mm,z_mm"), std::string::npos) << errorOf(q);
+  const auto r = writeTemp("d.csv", "x,y,z,nx,ny,nz\n1,2,3,0,0,2\n");
+  EXPECT_NE(errorOf(r).find("unit vector"), std::string::npos) << errorOf(r);
+}
+
+TEST(PointCloud, NistDsCountIsChecked) {
+  const auto ok = writeTemp("s.ds", "3\n1.00000 2.00000 3.00000\n4 5 6\n  7 8 9\n");
+  const auto pc = readPointCloud(ok);
+  ASSERT_EQ(pc.points_mm.size(), 3u);
+  EXPECT_EQ(pc.points_mm[2], Eigen::Vector3d(7, 8, 9));
+  const auto bad = writeTemp("t.ds", "4\n1 2 3\n4 5 6\n");
+  EXPECT_NE(errorOf(bad).find("header says 4 points, the file has 2"), std::string::npos) << errorOf(bad);
+}
+
+TEST(PointCloud, XyzBlanksCommasCommentsAndExtraColumns) {
+  const auto p = writeTemp("p.xyz", "# scan\n1 2 3 255 0 0\n4,5,6\n\n7\t8\t9 # tail\n");
+  const auto pc = readPointCloud(p);
+  ASSERT_EQ(pc.points_mm.size(), 3u);
+  EXPECT_EQ(pc.points_mm[1], Eigen::Vector3d(4, 5, 6));
+  EXPECT_EQ(pc.source_lines[2], 5);
+  const auto bad = writeTemp("q.xyz", "1 2 3\n1 2\n");
+  EXPECT_NE(errorOf(bad).find("q.xyz:2: expected 3 coordinates"), std::string::npos) << errorOf(bad);
+}
+
+TEST(PointCloud, PlyAsciiSkipsFacesAndOtherProperties) {
+  const auto p = writeTemp("m.ply",
+                           "ply\nformat ascii 1.0\ncomment made by hand\n"
+                           "element vertex 3\nproperty float x\nproperty uchar red\n"
+                           "property float y\nproperty float z\n"
+                           "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+                           "1 200 2 3\n4 0 5 6\n7 1 8 9\n3 0 1 2\n");
+  const auto pc = readPointCloud(p);
+  ASSERT_EQ(pc.points_mm.size(), 3u);
+  EXPECT_EQ(pc.points_mm[2], Eigen::Vector3d(7, 8, 9));
+}
+
+TEST(PointCloud, PlyBinaryBothEndiannesses) {
+  for (const bool big : {false, true}) {
+    std::string s = std::string("ply\nformat ") + (big ? "binary_big_endian" : "binary_little_endian") +
+                    " 1.0\nelement vertex 2\nproperty double x\nproperty double y\nproperty float z\n"
+                    "property list uchar int extra\nend_header\n";
+    auto put = [&](const void* v, size_t n) {
+      std::string b(static_cast<const char*>(v), n);
+      if (big) std::reverse(b.begin(), b.end());
+      s += b;
+    };
+    const double xs[2] = {1000.125, -3.5}, ys[2] = {2.25, 4.0};
+    const float zs[2] = {0.5f, -7.0f};
+    for (int i = 0; i < 2; ++i) {
+      put(&xs[i], 8);
+      put(&ys[i], 8);
+      put(&zs[i], 4);
+      const std::uint8_t n = 1;
+      s.push_back(static_cast<char>(n));
+      const std::int32_t v = 42;
+      put(&v, 4);
+    }
+    const auto pc = readPointCloud(writeTemp(big ? "be.ply" : "le.ply", s));
+    ASSERT_EQ(pc.points_mm.size(), 2u);
+    EXPECT_EQ(pc.points_mm[0], Eigen::Vector3d(1000.125, 2.25, 0.5));
+    EXPECT_EQ(pc.points_mm[1], Eigen::Vector3d(-3.5, 4.0, -7.0));
+  }
+}
+
+TEST(PointCloud, PlyTruncatedAndMissingCoordinatesAreErrors) {
+  const auto t = writeTemp("t.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 2\n"
+                                    "property double x\nproperty double y\nproperty double z\nend_header\n12345678");
+  EXPECT_NE(errorOf(t).find("binary data ends"), std::string::npos) << errorOf(t);
+  const auto m = writeTemp("m2.ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n1\n");
+  EXPECT_NE(errorOf(m).find("x, y and z"), std::string::npos) << errorOf(m);
+}
+
+TEST(PointCloud, UnknownExtensionAsksForFormat) {
+  const auto p = writeTemp("points.dat", "1 2 3\n");
+  EXPECT_NE(errorOf(p).find("--format"), std::string::npos);
+  EXPECT_EQ(readPointCloud(p, "xyz").points_mm.size(), 1u);
+  const auto e = writeTemp("empty.xyz", "# nothing\n");
+  EXPECT_NE(errorOf(e).find("no points"), std::string::npos);
+}
