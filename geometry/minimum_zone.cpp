@@ -1,18 +1,1177 @@
 #include "geometry/minimum_zone.hpp"
 
+// CGAL stays in this file: the headers are heavy and only these algorithms need them.
+#include <CGAL/Cartesian.h>
+#include <CGAL/Delaunay_triangulation_2.h>
+#include <CGAL/Exact_predicates_exact_constructions_kernel.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Gmpq.h>
+#include <CGAL/Gmpzf.h>
+#include <CGAL/Min_annulus_d.h>
+#include <CGAL/Min_circle_2.h>
+#include <CGAL/Min_circle_2_traits_2.h>
+#include <CGAL/Min_sphere_annulus_d_traits_2.h>
+#include <CGAL/Min_sphere_annulus_d_traits_3.h>
+#include <CGAL/Min_sphere_of_spheres_d.h>
+#include <CGAL/Min_sphere_of_spheres_d_traits_3.h>
+#include <CGAL/QP_functions.h>
+#include <CGAL/QP_models.h>
+#include <CGAL/Triangulation_vertex_base_with_info_2.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <optional>
+#include <sstream>
+#include <utility>
+
 #include "core/error.hpp"
+#include "geometry/least_squares.hpp"
+
+// How the fits work
+// -----------------
+// Every fit runs in the centroid frame (data ~1000 mm from the origin with um form keep
+// their digits) and ends with the same sequential linear-programming (SLP) stage:
+// linearise the residuals r_i(p + d) ~ r_i + J_i d around the current element, solve
+//   zone:  min hi - lo   s.t. lo <= r_i + J_i d <= hi      (minimum zone)
+//   outer: min hi        s.t.       r_i + J_i d <= hi      (minimum circumscribed)
+//   inner: max lo        s.t. lo <= r_i + J_i d            (maximum inscribed)
+// inside a trust box |d_j| <= D exactly (CGAL QP solver, Gmpzf, on the double data), step,
+// repeat; once the binding set repeats, Newton's method on the KKT conditions of that
+// active set (Hald & Madsen 1981) finishes quadratically. The LP is solved by constraint
+// generation: on the extreme points plus the previous binding set, adding the points the
+// linearised solution violates until none does, so 1e5 points cost O(n) per round and the
+// LPs stay tiny.
+// Where an exact CGAL algorithm fits, it provides the start and the SLP stage certifies
+// (and if need be polishes) it:
+//   circle2d mz / sphere mz / sphere mi: Min_annulus_d (exact, Gmpzf) on a growing
+//     subset. It minimises R^2 - r^2 (the LP form), not the zone width R - r, so the SLP
+//     then polishes the width; the two optima differ by second-order terms only.
+//   circle2d mc: Min_circle_2 (exact constructions). sphere mc: Min_sphere_of_spheres_d
+//     (Gmpq, exact with square-root extension) on a growing subset.
+//   circle2d mi: Delaunay triangulation: the largest empty circle whose centre is a local
+//     maximum (Voronoi vertex inside its Delaunay triangle) and is surrounded by the
+//     points.
+//   line2d mz: convex hull (exact orientation predicate) + rotating calipers.
+// Own SLP from a start: plane mz from PCA (the orthogonal least-squares plane; CGAL
+// Width_3 is exact but takes 0.7 s at 1e4 points, so it serves as the test reference);
+// line3d mz from the PCA line; cylinder mz/mi/mc from fitLeastSquares (or an own
+// Gauss-Newton cylinder while that is unavailable).
+//
+// Tolerances (S = largest distance of a point from the centroid, mm):
+// - convergence: the SLP stops when the linearised LP predicts an improvement below
+//   tol = 1e-13 mm + 2e-14 S in a box of at least sqrt(tol rho) (rho = curvature radius of
+//   the residuals, e.g. the radius). The nonlinear fits (circle, sphere, cylinder, line3d
+//   and the plane's tilt) are then first-order optimal, the zone width / radius within
+//   about tol of a local optimum (global for data near the element, form << size; the
+//   cylinder and line3d depend on their start for data far from the shape).
+// - support points: residual within 1e-9 mm + 1e-12 S of a zone boundary / the radius.
+// - alternation: a linearised problem with K unknowns (zone: geometric parameters + lo +
+//   hi; MI/MC: geometric parameters + radius) has K support points at a vertex optimum,
+//   i.e. k+1 for k element parameters (roundness 4, flatness 4, straightness 3,
+//   sphericity 5, cylindricity 6; MC/MI circle 3, sphere 4, cylinder and line3d 5). A
+//   nonlinear zone can instead have its optimum in a curved valley with one point fewer,
+//   where the curvature of the distances decides (seen for cylinders), and an MC circle
+//   can rest on a diametral pair. Both are accepted on the LP certificate above (no
+//   first-order improvement in the certification box); a fit without it throws rather
+//   than report an unverified zone.
+// - MI/MC: the radius is the min/max distance over all points in double, so every point
+//   is outside/inside to rounding (~1e-13 S).
 
 namespace probeloop::geometry {
+namespace {
 
-// SKELETON (being implemented): keeps the tree linking while the suite is written.
-FitResult fitMinimumZone(ElementKind kind, const Points3&) {
-  throw GeometryError("minimum zone " + std::string(elementName(kind)) + " not implemented yet");
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+using Eigen::VectorXd;
+using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+// ------------------------------------------------------------------ small helpers
+
+std::string fmt(double v, int precision = 6) {
+  std::ostringstream s;
+  s.precision(precision);
+  s << v;
+  return s.str();
 }
-FitResult fitMaximumInscribed(ElementKind kind, const Points3&) {
-  throw GeometryError("maximum inscribed " + std::string(elementName(kind)) + " not implemented yet");
+
+std::string methodLabel(FitMethod m) {
+  switch (m) {
+    case FitMethod::MinimumZone: return "minimum-zone";
+    case FitMethod::MaximumInscribed: return "maximum-inscribed";
+    case FitMethod::MinimumCircumscribed: return "minimum-circumscribed";
+    case FitMethod::LeastSquares: return "least-squares";
+  }
+  return "unknown";
 }
-FitResult fitMinimumCircumscribed(ElementKind kind, const Points3&) {
-  throw GeometryError("minimum circumscribed " + std::string(elementName(kind)) + " not implemented yet");
+
+// Canonical sign of a direction: largest-magnitude component positive (elements.hpp).
+Vector3d canonical(const Vector3d& d) {
+  Eigen::Index i = 0;
+  d.cwiseAbs().maxCoeff(&i);
+  return d[i] < 0.0 ? Vector3d(-d) : d;
+}
+
+Vector3d anyPerpendicular(const Vector3d& d) {
+  const Vector3d a = std::abs(d.x()) < 0.9 ? Vector3d::UnitX() : Vector3d::UnitY();
+  return (a - d * d.dot(a)).normalized();
+}
+
+// Eigen decomposition of the scatter of centred points (ascending eigenvalues).
+Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> scatter(const Points3& q) {
+  Eigen::Matrix3d c = Eigen::Matrix3d::Zero();
+  for (const auto& p : q) c += p * p.transpose();
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(c);
+}
+
+double maxAbsDot(const Points3& q, const Vector3d& n) {
+  double m = 0.0;
+  for (const auto& p : q) m = std::max(m, std::abs(n.dot(p)));
+  return m;
+}
+
+// ------------------------------------------------------------------ the problem
+
+// The input moved to its centroid, with the scale that sets every tolerance.
+struct Frame {
+  Vector3d origin = Vector3d::Zero();
+  Points3 q;            // centred points (2D kinds: z = 0)
+  double size = 1.0;    // S: largest |q_i|
+  double tol = 0.0;     // SLP convergence tolerance on the objective, mm
+  double support = 0.0; // support-point tolerance, mm
+  double noise = 0.0;   // rounding level of a residual, mm
+};
+
+bool planar2d(ElementKind k) { return k == ElementKind::Line2D || k == ElementKind::Circle2D; }
+
+Frame makeFrame(ElementKind kind, const Points3& points) {
+  Frame f;
+  const bool flat = planar2d(kind);
+  Vector3d c = Vector3d::Zero();
+  for (const auto& p : points) c += p;
+  c /= static_cast<double>(points.size());
+  if (flat) c.z() = 0.0;
+  f.origin = c;
+  f.q.reserve(points.size());
+  double s = 0.0;
+  for (const auto& p : points) {
+    Vector3d v = p - c;
+    if (flat) v.z() = 0.0;
+    s = std::max(s, v.norm());
+    f.q.push_back(v);
+  }
+  f.size = std::max(s, 1e-300);
+  f.tol = 1e-13 + 2e-14 * f.size;
+  f.support = 1e-9 + 1e-12 * f.size;
+  f.noise = 1e-15 * (f.size + 1.0);
+  return f;
+}
+
+// The centred problem, after rejecting degenerate input with what is wrong and what would
+// fix it (same wording style as least squares).
+Frame prepare(ElementKind kind, FitMethod method, const Points3& points) {
+  const std::string what = methodLabel(method) + " " + std::string(elementName(kind));
+  const int need = minimumPoints(kind);
+  if (static_cast<int>(points.size()) < need)
+    throw GeometryError(what + " needs at least " + std::to_string(need) + " points, got " +
+                        std::to_string(points.size()) + "; probe more points");
+  for (size_t i = 0; i < points.size(); ++i)
+    if (!points[i].allFinite())
+      throw GeometryError(what + ": point " + std::to_string(i) + " is not finite (" +
+                          fmt(points[i].x()) + ", " + fmt(points[i].y()) + ", " +
+                          fmt(points[i].z()) + "); remove or re-measure it");
+  Frame f = makeFrame(kind, points);
+  const std::string n = std::to_string(points.size());
+  if (f.size <= 1e-12 + 1e-14 * f.origin.norm())
+    throw GeometryError(what + " needs at least 2 distinct points; all " + n +
+                        " points coincide" + (planar2d(kind) ? " in x, y" : ""));
+  const auto eig = scatter(f.q);
+  // Thickness of the point set across its best line / plane (relative to its size).
+  const double rel = 1e-9;
+  auto acrossLine = [&] {
+    const Vector3d axis = eig.eigenvectors().col(2);
+    double m = 0.0;
+    for (const auto& p : f.q) m = std::max(m, (p - axis * axis.dot(p)).norm());
+    return m;
+  };
+  switch (kind) {
+    case ElementKind::Circle2D:
+    case ElementKind::Plane:
+    case ElementKind::Cylinder: {
+      const double t = acrossLine();
+      if (t <= rel * f.size)
+        throw GeometryError(what + " needs at least " + std::to_string(need) +
+                            " non-collinear points; these " + n + " points lie within " +
+                            fmt(t) + " mm of a line. Probe points off that line.");
+      if (kind == ElementKind::Cylinder) {
+        const double h = maxAbsDot(f.q, eig.eigenvectors().col(0));
+        if (h <= rel * f.size)
+          throw GeometryError(what + " needs points that are not coplanar (more than one "
+                              "section along the axis); these " + n + " points lie within " +
+                              fmt(h) + " mm of a plane. Probe a second section.");
+      }
+      break;
+    }
+    case ElementKind::Sphere: {
+      const double h = maxAbsDot(f.q, eig.eigenvectors().col(0));
+      if (h <= rel * f.size)
+        throw GeometryError(what + " needs at least 4 non-coplanar points; these " + n +
+                            " points lie within " + fmt(h) + " mm of a plane. Probe points "
+                            "off that plane (e.g. the pole).");
+      break;
+    }
+    default: break;
+  }
+  return f;
+}
+
+void requireKind(ElementKind kind, FitMethod method, std::initializer_list<ElementKind> ok) {
+  if (std::find(ok.begin(), ok.end(), kind) != ok.end()) return;
+  std::string list;
+  for (auto k : ok) list += (list.empty() ? "" : ", ") + std::string(elementName(k));
+  throw GeometryError(methodLabel(method) + " fit of a " + std::string(elementName(kind)) +
+                      " is not defined; supported kinds: " + list);
+}
+
+// ------------------------------------------------------------------ models
+
+// Every model: int params() const; double residual(int i, double* grad) const (grad: the
+// row of J, may be null); Model stepped(const VectorXd& delta) const (a retraction: the
+// model moved by delta in its own chart).
+template <class Model>
+void evaluateAll(const Model& m, VectorXd& r, RowMatrix* J) {
+  const int n = static_cast<int>(r.size());
+  for (int i = 0; i < n; ++i) r[i] = m.residual(i, J ? J->row(i).data() : nullptr);
+}
+
+// Circle (D = 2) or sphere (D = 3) centre; residual = distance from the centre.
+template <int D>
+struct CentreModel {
+  using Vec = Eigen::Matrix<double, D, 1>;
+  const Points3* q = nullptr;
+  Vec c = Vec::Zero();
+  int params() const { return D; }
+  // Length over which the linearisation error grows to the residual's size: 1/curvature.
+  double curvatureRadius(const VectorXd& r) const { return r.maxCoeff(); }
+  double residual(int i, double* g) const {
+    const Vec v = (*q)[i].template head<D>() - c;
+    const double d = v.norm();
+    if (g)
+      for (int k = 0; k < D; ++k) g[k] = d > 0.0 ? -v[k] / d : 0.0;
+    return d;
+  }
+  CentreModel stepped(const VectorXd& delta) const {
+    CentreModel m = *this;
+    m.c += delta.head<D>();
+    return m;
+  }
+};
+
+// Plane through the centroid frame; residual = n . q. Parameters: tilt of n toward e1,
+// e2 (times the frame size L, so they are mm at the rim).
+struct PlaneModel {
+  const Points3* q = nullptr;
+  Vector3d n, e1, e2;
+  double L = 1.0;
+  PlaneModel(const Points3* pts, const Vector3d& normal, double size) : q(pts), L(size) {
+    setNormal(normal.normalized(), anyPerpendicular(normal.normalized()));
+  }
+  void setNormal(const Vector3d& normal, const Vector3d& hint) {
+    n = normal;
+    e1 = (hint - n * n.dot(hint)).normalized();
+    e2 = n.cross(e1);
+  }
+  int params() const { return 2; }
+  double curvatureRadius(const VectorXd&) const { return L; }
+  double residual(int i, double* g) const {
+    const Vector3d& p = (*q)[i];
+    if (g) g[0] = e1.dot(p) / L, g[1] = e2.dot(p) / L;
+    return n.dot(p);
+  }
+  PlaneModel stepped(const VectorXd& d) const {
+    PlaneModel m = *this;
+    m.setNormal((n + (d[0] * e1 + d[1] * e2) / L).normalized(), e1);
+    return m;
+  }
+};
+
+// Line in the xy plane through the centroid frame; residual = left normal . q.
+// Parameter: rotation angle (times L).
+struct Line2Model {
+  const Points3* q = nullptr;
+  Vector2d d;  // unit direction
+  double L = 1.0;
+  Vector2d normal() const { return Vector2d(-d.y(), d.x()); }
+  int params() const { return 1; }
+  double curvatureRadius(const VectorXd&) const { return L; }
+  double residual(int i, double* g) const {
+    const Vector2d p = (*q)[i].head<2>();
+    if (g) g[0] = -d.dot(p) / L;  // d(normal)/d(angle) = -d
+    return normal().dot(p);
+  }
+  Line2Model stepped(const VectorXd& delta) const {
+    Line2Model m = *this;
+    const double a = delta[0] / L;
+    m.d = Vector2d(std::cos(a) * d.x() - std::sin(a) * d.y(),
+                   std::sin(a) * d.x() + std::cos(a) * d.y())
+              .normalized();
+    return m;
+  }
+};
+
+// Axis (cylinder, line3d); residual = distance from the axis. p0 is the axis point
+// nearest the centroid, a the unit axis, e1/e2 complete the frame. Parameters: shift of
+// the axis point along e1, e2 (mm) and tilt of a toward e1, e2 (times L).
+// Derivatives (v = q - p0, s = v.a, w = v - s a, u = w/|w|):
+//   d|w|/d shift_k = -u.e_k,  d|w|/d tilt_k = -s (u.e_k) / L.
+struct AxisModel {
+  const Points3* q = nullptr;
+  Vector3d p0, a, e1, e2;
+  double L = 1.0;
+  AxisModel(const Points3* pts, const Vector3d& point, const Vector3d& axis, double size)
+      : q(pts), L(size) {
+    set(point, axis.normalized(), anyPerpendicular(axis.normalized()));
+  }
+  void set(const Vector3d& point, const Vector3d& axis, const Vector3d& hint) {
+    a = axis;
+    p0 = point - a * a.dot(point);  // nearest the centroid (the frame origin)
+    e1 = (hint - a * a.dot(hint)).normalized();
+    e2 = a.cross(e1);
+  }
+  int params() const { return 4; }
+  double curvatureRadius(const VectorXd& r) const { return r.maxCoeff(); }
+  double residual(int i, double* g) const {
+    const Vector3d v = (*q)[i] - p0;
+    const double s = v.dot(a);
+    const Vector3d w = v - s * a;
+    const double d = w.norm();
+    if (g) {
+      const double u1 = d > 0.0 ? w.dot(e1) / d : 0.0;
+      const double u2 = d > 0.0 ? w.dot(e2) / d : 0.0;
+      g[0] = -u1;
+      g[1] = -u2;
+      g[2] = -s * u1 / L;
+      g[3] = -s * u2 / L;
+    }
+    return d;
+  }
+  AxisModel stepped(const VectorXd& d) const {
+    AxisModel m = *this;
+    m.set(p0 + d[0] * e1 + d[1] * e2, (a + (d[2] * e1 + d[3] * e2) / L).normalized(), e1);
+    return m;
+  }
+};
+
+// ------------------------------------------------------------------ linearised LP
+
+enum class Goal { Zone, Outer, Inner };
+
+double objective(const VectorXd& r, Goal g) {
+  switch (g) {
+    case Goal::Zone: return r.maxCoeff() - r.minCoeff();
+    case Goal::Outer: return r.maxCoeff();
+    case Goal::Inner: return -r.minCoeff();
+  }
+  return 0.0;
+}
+
+// Indices of the k largest and/or k smallest residuals (all of them for small n).
+void addExtremes(const VectorXd& r, Goal g, int k, std::vector<int>& out) {
+  const int n = static_cast<int>(r.size());
+  if (n <= 4 * k) {
+    for (int i = 0; i < n; ++i) out.push_back(i);
+    return;
+  }
+  std::vector<int> idx(n);
+  std::iota(idx.begin(), idx.end(), 0);
+  if (g != Goal::Inner) {
+    std::nth_element(idx.begin(), idx.begin() + k, idx.end(),
+                     [&](int a, int b) { return r[a] > r[b]; });
+    out.insert(out.end(), idx.begin(), idx.begin() + k);
+  }
+  if (g != Goal::Outer) {
+    std::nth_element(idx.begin(), idx.begin() + k, idx.end(),
+                     [&](int a, int b) { return r[a] < r[b]; });
+    out.insert(out.end(), idx.begin(), idx.begin() + k);
+  }
+}
+
+void dedupe(std::vector<int>& v) {
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+}
+
+struct LpStep {
+  VectorXd delta;
+  double model = 0.0;          // objective of the linearised problem at delta
+  std::vector<int> upper;      // binding at hi (zone, outer)
+  std::vector<int> lower;      // binding at lo (zone, inner)
+};
+
+// Exact solution (on the double data) of the linearised problem over all points inside
+// the box |delta_j| <= box, by constraint generation starting from `active`.
+LpStep solveLinearised(const VectorXd& r, const RowMatrix& J, Goal goal, double box,
+                       std::vector<int> active, double noise) {
+  const int m = static_cast<int>(J.cols());
+  const int n = static_cast<int>(r.size());
+  const int hi = m;
+  const int lo = goal == Goal::Zone ? m + 1 : m;
+  dedupe(active);
+  for (int round = 0; round < 200; ++round) {
+    CGAL::Quadratic_program<double> lp(CGAL::SMALLER, false, 0.0, false, 0.0);
+    int row = 0;
+    for (int i : active) {
+      if (goal != Goal::Inner) {  // r_i + J_i d <= hi
+        for (int j = 0; j < m; ++j) lp.set_a(j, row, J(i, j));
+        lp.set_a(hi, row, -1.0);
+        lp.set_b(row, -r[i]);
+        lp.set_r(row, CGAL::SMALLER);
+        ++row;
+      }
+      if (goal != Goal::Outer) {  // r_i + J_i d >= lo
+        for (int j = 0; j < m; ++j) lp.set_a(j, row, J(i, j));
+        lp.set_a(lo, row, -1.0);
+        lp.set_b(row, -r[i]);
+        lp.set_r(row, CGAL::LARGER);
+        ++row;
+      }
+    }
+    for (int j = 0; j < m; ++j) {
+      lp.set_l(j, true, -box);
+      lp.set_u(j, true, box);
+    }
+    if (goal != Goal::Inner) lp.set_c(hi, 1.0);
+    if (goal != Goal::Outer) lp.set_c(lo, -1.0);
+    const auto sol = CGAL::solve_linear_program(lp, CGAL::Gmpzf());
+    if (!sol.is_optimal())  // bounded box and free hi/lo: always optimal
+      throw GeometryError("internal error: linearised Chebyshev LP not optimal");
+    std::vector<double> x;
+    for (auto it = sol.variable_values_begin(); it != sol.variable_values_end(); ++it)
+      x.push_back(CGAL::to_double(*it));
+    x.resize(m + 2, 0.0);
+    LpStep step;
+    step.delta = Eigen::Map<const VectorXd>(x.data(), m);
+    const double vhi = x[hi];
+    const double vlo = x[lo];
+    const VectorXd lin = r + J * step.delta;
+    // Worst violators on each side.
+    std::vector<std::pair<double, int>> up, down;
+    for (int i = 0; i < n; ++i) {
+      if (goal != Goal::Inner && lin[i] - vhi > noise) up.push_back({lin[i] - vhi, i});
+      if (goal != Goal::Outer && vlo - lin[i] > noise) down.push_back({vlo - lin[i], i});
+    }
+    const size_t per_round = static_cast<size_t>(m + 2);
+    std::vector<int> fresh;  // violators not yet in the (sorted) active set
+    auto take = [&](std::vector<std::pair<double, int>>& v) {
+      std::sort(v.begin(), v.end(), std::greater<>());
+      for (size_t k = 0; k < v.size() && k < per_round; ++k)
+        if (!std::binary_search(active.begin(), active.end(), v[k].second))
+          fresh.push_back(v[k].second);
+    };
+    take(up);
+    take(down);
+    const size_t added = fresh.size();
+    active.insert(active.end(), fresh.begin(), fresh.end());
+    if (added == 0) {  // no violator outside the active set: optimal over all points
+      step.model = goal == Goal::Zone ? vhi - vlo : goal == Goal::Outer ? vhi : -vlo;
+      const double bind = 64.0 * noise;  // exact LP: binding rows differ by rounding only
+      for (int i : active) {
+        if (goal != Goal::Inner && std::abs(lin[i] - vhi) <= bind) step.upper.push_back(i);
+        if (goal != Goal::Outer && std::abs(lin[i] - vlo) <= bind) step.lower.push_back(i);
+      }
+      return step;
+    }
+    dedupe(active);
+  }
+  throw GeometryError("internal error: constraint generation for the Chebyshev LP did not "
+                      "terminate");
+}
+
+struct SlpOutcome {
+  int iterations = 0;
+  bool converged = false;
+  double objective = 0.0;
+};
+
+// Second stage of Hald & Madsen (1981, "Combined LP and quasi-Newton methods for minimax
+// optimization", Math. Programming 20): once the LP stage has found the active set, solve
+// the KKT conditions on it by Newton's method. This converges quadratically also where the
+// optimum is not a vertex of the linearised problem (a curved valley of the objective with
+// fewer than k+1 active points, common for cylinders), where the LP stage alone crawls.
+// Unknowns: step t (m), hi, lo, multipliers l_i; with s_i = +1 (upper), -1 (lower):
+//   sum_i s_i l_i g_i + W t = 0,  W = sum_i s_i l_i' H_i (l' = current multipliers)
+//   sum_upper l_i = 1, sum_lower l_i = 1
+//   r_i + g_i.t - hi = 0 (upper),  r_i + g_i.t - lo = 0 (lower)
+// H_i by central second differences of r_i in the model's chart. Returns the improved
+// model, or nothing when the active set is not the right one (negative multipliers, a
+// singular system, or a worse objective over all points).
+template <class Model>
+std::optional<Model> newtonStage(const Model& start, const std::vector<int>& upper,
+                                 const std::vector<int>& lower, Goal goal, double obj,
+                                 double rho, const Frame& f) {
+  const int m = start.params();
+  std::vector<int> idx(upper);
+  idx.insert(idx.end(), lower.begin(), lower.end());
+  const int p = static_cast<int>(idx.size());
+  const int nu = static_cast<int>(upper.size());
+  const bool two = goal == Goal::Zone;
+  const int nv = m + (two ? 2 : 1) + p;  // unknowns
+  if (p == 0 || p > m + (two ? 2 : 1) || (two && (upper.empty() || lower.empty()))) return {};
+  auto sign = [&](int k) { return k < nu ? 1.0 : -1.0; };
+  // Difference step: truncation ~ (h/rho)^2, rounding ~ 1e-16 S / h^2 relative to 1/rho.
+  const double h = 1e-3 * rho;
+  Model model = start;
+  Eigen::VectorXd lambda;  // current multipliers
+  for (int iter = 0; iter < 12; ++iter) {
+    RowMatrix G(p, m);
+    Eigen::VectorXd r(p);
+    for (int k = 0; k < p; ++k) r[k] = model.residual(idx[k], G.row(k).data());
+    if (iter == 0) {  // multipliers from the stationarity conditions (least squares)
+      Eigen::MatrixXd A = Eigen::MatrixXd::Zero(m + (two ? 2 : 1), p);
+      Eigen::VectorXd b = Eigen::VectorXd::Zero(A.rows());
+      for (int k = 0; k < p; ++k) {
+        A.col(k).head(m) = sign(k) * G.row(k).transpose();
+        A(m + ((two && k >= nu) ? 1 : 0), k) = 1.0;
+      }
+      b.tail(two ? 2 : 1).setOnes();
+      lambda = A.colPivHouseholderQr().solve(b);
+      if (!lambda.allFinite() || lambda.minCoeff() <= 0.0) return {};
+    }
+    // Hessians of the active residuals (central differences in this chart).
+    Eigen::MatrixXd W = Eigen::MatrixXd::Zero(m, m);
+    for (int a = 0; a < m; ++a)
+      for (int b = a; b < m; ++b) {
+        Eigen::VectorXd e = Eigen::VectorXd::Zero(m);
+        auto at = [&](double sa, double sb) {
+          e.setZero();
+          e[a] += sa * h;
+          e[b] += sb * h;
+          const Model t = model.stepped(e);
+          Eigen::VectorXd v(p);
+          for (int k = 0; k < p; ++k) v[k] = t.residual(idx[k], nullptr);
+          return v;
+        };
+        // With a == b, at(+-1, +-1) moves by 2h: the second difference with step 2h.
+        const Eigen::VectorXd d2 = a == b ? Eigen::VectorXd((at(1, 1) - 2 * r + at(-1, -1)) / (4 * h * h))
+                                          : Eigen::VectorXd((at(1, 1) - at(1, -1) - at(-1, 1) + at(-1, -1)) / (4 * h * h));
+        double w = 0.0;
+        for (int k = 0; k < p; ++k) w += sign(k) * lambda[k] * d2[k];
+        W(a, b) = W(b, a) = w;
+      }
+    if (goal == Goal::Inner) W = -W;  // objective -lo: stationarity of -lo + sum l (lo - r)
+    Eigen::MatrixXd K = Eigen::MatrixXd::Zero(nv, nv);
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(nv);
+    const int ihi = m, ilo = two ? m + 1 : m, il = m + (two ? 2 : 1);
+    K.topLeftCorner(m, m) = W;
+    for (int k = 0; k < p; ++k) {
+      const double sk = goal == Goal::Inner ? -1.0 : sign(k);
+      K.block(0, il + k, m, 1) = sk * G.row(k).transpose();
+      const int norm_row = m + ((two && k >= nu) ? 1 : 0);
+      K(norm_row, il + k) = 1.0;
+      const int row = il + k;
+      K.block(row, 0, 1, m) = G.row(k);
+      K(row, (k < nu && goal != Goal::Inner) ? ihi : ilo) = -1.0;
+      rhs[row] = -r[k];
+    }
+    rhs.segment(m, two ? 2 : 1).setOnes();
+    const Eigen::FullPivLU<Eigen::MatrixXd> lu(K);
+    if (lu.rank() < nv) return {};
+    const Eigen::VectorXd z = lu.solve(rhs);
+    if (!z.allFinite()) return {};
+    lambda = z.tail(p);
+    if (lambda.minCoeff() <= 0.0) return {};
+    const Eigen::VectorXd t = z.head(m);
+    model = model.stepped(t);
+    if (t.cwiseAbs().maxCoeff() <= 1e-15 * f.size) break;
+  }
+  VectorXd all(f.q.size());
+  evaluateAll(model, all, nullptr);
+  if (!(objective(all, goal) < obj)) return {};
+  return model;
+}
+
+// Trust-region sequential LP (stage 1) with the Newton stage above once the active set
+// repeats. All parameters are in mm (angles scaled by the frame size) so one box fits all.
+// Converged when the LP, in a box of at least sqrt(tol rho) (rho = curvature radius of the
+// residuals: the box beyond which a remaining slope would mean more than tol to gain),
+// predicts less than tol improvement.
+template <class Model>
+SlpOutcome runSlp(Model& model, Goal goal, const Frame& f, double box, int max_iterations) {
+  const int n = static_cast<int>(f.q.size());
+  const int m = model.params();
+  VectorXd r(n), rt(n);
+  RowMatrix J(n, m);
+  evaluateAll(model, r, &J);
+  double obj = objective(r, goal);
+  const double box_max = 4.0 * f.size;
+  const double box_min = 1e-15 * f.size;
+  const double rho = std::max(model.curvatureRadius(r), 1e-9 * f.size + 1e-12);
+  const double box_cert = std::sqrt(f.tol * rho);
+  box = std::clamp(box, 16.0 * box_min, box_max);
+  std::vector<int> keep, last_upper, last_lower;
+  SlpOutcome out;
+  for (int it = 0; it < max_iterations; ++it) {
+    std::vector<int> active = keep;
+    addExtremes(r, goal, m + 2, active);
+    const LpStep step = solveLinearised(r, J, goal, box, active, f.noise);
+    keep = step.upper;
+    keep.insert(keep.end(), step.lower.begin(), step.lower.end());
+    const double predicted = obj - step.model;
+    ++out.iterations;
+    if (predicted <= f.tol) {
+      if (box >= box_cert) {
+        out.converged = true;
+        break;
+      }
+      box = box_cert;  // certify in a meaningful box
+      continue;
+    }
+    if (step.upper == last_upper && step.lower == last_lower) {
+      if (auto better = newtonStage(model, step.upper, step.lower, goal, obj, rho, f)) {
+        model = *better;
+        evaluateAll(model, r, &J);
+        obj = objective(r, goal);
+        box = std::max(box, box_cert);
+        continue;
+      }
+    }
+    last_upper = step.upper;
+    last_lower = step.lower;
+    const double len = step.delta.cwiseAbs().maxCoeff();
+    Model trial = model.stepped(step.delta);
+    evaluateAll(trial, rt, nullptr);
+    double trial_obj = objective(rt, goal);
+    const double ratio = (obj - trial_obj) / predicted;  // actual / predicted decrease
+    double taken = len;  // length of the accepted step
+    if (ratio < 0.25) {
+      // Curvature the LP does not see: minimise the quadratic through f(0), its predicted
+      // slope and f(delta) along delta instead of only shrinking the box.
+      const double c = trial_obj - obj + predicted;
+      if (c > 0.0) {
+        const double t = std::clamp(predicted / (2.0 * c), 0.02, 0.98);
+        Model mid = model.stepped(t * step.delta);
+        evaluateAll(mid, rt, nullptr);
+        const double mid_obj = objective(rt, goal);
+        if (mid_obj < trial_obj) {
+          trial = mid;
+          trial_obj = mid_obj;
+          taken = t * len;
+        }
+      }
+    }
+    if (trial_obj < obj) {
+      model = trial;
+      obj = trial_obj;
+      evaluateAll(model, r, &J);
+      if (ratio > 0.75 && len >= 0.9 * box) box = std::min(2.0 * box, box_max);
+      else if (ratio < 0.25) box = std::max(box_min, std::min(2.0 * taken, box));
+    } else {
+      box = 0.25 * len;
+      if (box < box_min) break;  // steps at rounding level without certificate
+    }
+  }
+  out.objective = obj;
+  return out;
+}
+
+// ------------------------------------------------------------------ exact CGAL parts
+
+// Min_annulus_d (exact, Gmpzf) centre of the centred points, on a growing subset: the
+// problem is an LP (minimise R^2 - r^2), so adding the points outside the current
+// annulus converges to the annulus of all points in a few small solves.
+template <int D>
+Eigen::Matrix<double, D, 1> annulusCentre(const Frame& f) {
+  using K = CGAL::Cartesian<double>;
+  using Traits = std::conditional_t<D == 2, CGAL::Min_sphere_annulus_d_traits_2<K, CGAL::Gmpzf, double>,
+                                    CGAL::Min_sphere_annulus_d_traits_3<K, CGAL::Gmpzf, double>>;
+  using Point = std::conditional_t<D == 2, K::Point_2, K::Point_3>;
+  using Vec = Eigen::Matrix<double, D, 1>;
+  const int n = static_cast<int>(f.q.size());
+  auto point = [&](int i) {
+    if constexpr (D == 2) return Point(f.q[i].x(), f.q[i].y());
+    else return Point(f.q[i].x(), f.q[i].y(), f.q[i].z());
+  };
+  // Start: extremes of the distance from the centroid, plus an even sample.
+  VectorXd d0(n);
+  for (int i = 0; i < n; ++i) d0[i] = f.q[i].template head<D>().norm();
+  std::vector<int> active;
+  addExtremes(d0, Goal::Zone, 8, active);
+  const int stride = std::max(1, n / 48);
+  for (int i = 0; i < n; i += stride) active.push_back(i);
+  dedupe(active);
+  Vec c = Vec::Zero();
+  for (int round = 0; round < 100; ++round) {
+    std::vector<Point> pts;
+    for (int i : active) pts.push_back(point(i));
+    CGAL::Min_annulus_d<Traits> ann(pts.begin(), pts.end());
+    std::vector<double> h;
+    for (auto it = ann.center_coordinates_begin(); it != ann.center_coordinates_end(); ++it)
+      h.push_back(CGAL::to_double(*it));
+    for (int k = 0; k < D; ++k) c[k] = h[k] / h[D];  // homogeneous, last = denominator
+    const double den = CGAL::to_double(ann.squared_radii_denominator());
+    const double ro = std::sqrt(std::max(0.0, CGAL::to_double(ann.squared_outer_radius_numerator()) / den));
+    const double ri = std::sqrt(std::max(0.0, CGAL::to_double(ann.squared_inner_radius_numerator()) / den));
+    std::vector<std::pair<double, int>> out;
+    const double eps = 1e-12 * (ro + 1.0);
+    for (int i = 0; i < n; ++i) {
+      const double d = (f.q[i].template head<D>() - c).norm();
+      if (d > ro + eps) out.push_back({d - ro, i});
+      else if (d < ri - eps) out.push_back({ri - d, i});
+    }
+    std::sort(out.begin(), out.end(), std::greater<>());
+    const size_t before = active.size();
+    for (size_t k = 0; k < out.size() && k < 16; ++k) active.push_back(out[k].second);
+    dedupe(active);
+    if (active.size() == before) break;
+  }
+  return c;
+}
+
+Vector2d minCircleCentre(const Frame& f) {
+  using K = CGAL::Exact_predicates_exact_constructions_kernel;
+  std::vector<K::Point_2> pts;
+  pts.reserve(f.q.size());
+  for (const auto& p : f.q) pts.emplace_back(p.x(), p.y());
+  CGAL::Min_circle_2<CGAL::Min_circle_2_traits_2<K>> mc(pts.begin(), pts.end(), true);
+  const auto c = mc.circle().center();
+  return Vector2d(CGAL::to_double(c.x()), CGAL::to_double(c.y()));
+}
+
+// Smallest enclosing sphere: Min_sphere_of_spheres_d with Gmpq and the square-root
+// extension (exact), on a growing subset (points outside the current ball are added).
+Vector3d minSphereCentre(const Frame& f) {
+  using K = CGAL::Cartesian<CGAL::Gmpq>;
+  using Traits = CGAL::Min_sphere_of_spheres_d_traits_3<K, CGAL::Gmpq, CGAL::Tag_false>;
+  const int n = static_cast<int>(f.q.size());
+  VectorXd d0(n);
+  for (int i = 0; i < n; ++i) d0[i] = f.q[i].norm();
+  std::vector<int> active;
+  addExtremes(d0, Goal::Outer, 8, active);
+  for (int k = 0; k < 3; ++k) {  // extremes along the axes
+    int lo = 0, hi = 0;
+    for (int i = 0; i < n; ++i) {
+      if (f.q[i][k] < f.q[lo][k]) lo = i;
+      if (f.q[i][k] > f.q[hi][k]) hi = i;
+    }
+    active.push_back(lo);
+    active.push_back(hi);
+  }
+  dedupe(active);
+  Vector3d c = Vector3d::Zero();
+  for (int round = 0; round < 100; ++round) {
+    std::vector<Traits::Sphere> balls;
+    for (int i : active)
+      balls.emplace_back(K::Point_3(f.q[i].x(), f.q[i].y(), f.q[i].z()), CGAL::Gmpq(0));
+    CGAL::Min_sphere_of_spheres_d<Traits> ms(balls.begin(), balls.end());
+    const double disc = std::sqrt(std::max(0.0, CGAL::to_double(ms.discriminant())));
+    auto it = ms.center_cartesian_begin();
+    for (int k = 0; k < 3; ++k, ++it)
+      c[k] = CGAL::to_double(it->first) + CGAL::to_double(it->second) * disc;
+    const double R = CGAL::to_double(ms.radius().first) + CGAL::to_double(ms.radius().second) * disc;
+    std::vector<std::pair<double, int>> out;
+    for (int i = 0; i < n; ++i) {
+      const double d = (f.q[i] - c).norm();
+      if (d > R + 1e-12 * (R + 1.0)) out.push_back({d - R, i});
+    }
+    std::sort(out.begin(), out.end(), std::greater<>());
+    const size_t before = active.size();
+    for (size_t k = 0; k < out.size() && k < 16; ++k) active.push_back(out[k].second);
+    dedupe(active);
+    if (active.size() == before) break;
+  }
+  return c;
+}
+
+// Largest angle (rad) between consecutive directions from c to the points, seen in xy.
+double largestAngularGap(const Points3& q, const Vector2d& c) {
+  std::vector<double> ang;
+  ang.reserve(q.size());
+  for (const auto& p : q) {
+    const Vector2d v = p.head<2>() - c;
+    if (v.squaredNorm() > 0.0) ang.push_back(std::atan2(v.y(), v.x()));
+  }
+  if (ang.size() < 2) return 2.0 * M_PI;
+  std::sort(ang.begin(), ang.end());
+  double gap = ang.front() + 2.0 * M_PI - ang.back();
+  for (size_t i = 1; i < ang.size(); ++i) gap = std::max(gap, ang[i] - ang[i - 1]);
+  return gap;
+}
+
+// Largest empty circle through a Delaunay triangle whose circumcentre lies inside (or on)
+// the triangle (a local maximum of the distance to the nearest point: the Voronoi vertex
+// lies in the convex hull of its nearest points) and is surrounded by all the points
+// (largest angular gap < 180 deg, i.e. the centre is strictly inside their hull).
+Vector2d maxInscribedCircleCentre(const Frame& f) {
+  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+  using E = CGAL::Exact_predicates_exact_constructions_kernel;
+  using Vb = CGAL::Triangulation_vertex_base_with_info_2<int, K>;
+  using Tds = CGAL::Triangulation_data_structure_2<Vb>;
+  using Dt = CGAL::Delaunay_triangulation_2<K, Tds>;
+  std::vector<std::pair<K::Point_2, int>> pts;
+  for (size_t i = 0; i < f.q.size(); ++i)
+    pts.push_back({K::Point_2(f.q[i].x(), f.q[i].y()), static_cast<int>(i)});
+  Dt dt(pts.begin(), pts.end());
+  struct Candidate {
+    double r2;
+    Vector2d c;
+  };
+  std::vector<Candidate> cand;
+  for (auto fh = dt.finite_faces_begin(); fh != dt.finite_faces_end(); ++fh) {
+    E::Point_2 v[3];
+    for (int k = 0; k < 3; ++k) v[k] = E::Point_2(fh->vertex(k)->point().x(), fh->vertex(k)->point().y());
+    if (CGAL::angle(v[2], v[0], v[1]) == CGAL::OBTUSE || CGAL::angle(v[0], v[1], v[2]) == CGAL::OBTUSE ||
+        CGAL::angle(v[1], v[2], v[0]) == CGAL::OBTUSE)
+      continue;
+    const E::Point_2 cc = CGAL::circumcenter(v[0], v[1], v[2]);
+    cand.push_back({CGAL::to_double(CGAL::squared_distance(cc, v[0])),
+                    Vector2d(CGAL::to_double(cc.x()), CGAL::to_double(cc.y()))});
+  }
+  std::sort(cand.begin(), cand.end(), [](const Candidate& a, const Candidate& b) { return a.r2 > b.r2; });
+  double best_gap = 2.0 * M_PI;
+  for (size_t k = 0; k < cand.size() && k < 32; ++k) {
+    const double gap = largestAngularGap(f.q, cand[k].c);
+    if (gap < M_PI * (1.0 - 1e-12)) return cand[k].c;
+    best_gap = std::min(best_gap, gap);
+  }
+  const std::string seen =
+      cand.empty() ? "no Delaunay triangle contains its circumcentre"
+                   : "every candidate centre sees a gap of at least " +
+                         fmt(best_gap * 180.0 / M_PI, 4) + " deg between them; it must be < 180 deg";
+  throw GeometryError(
+      "maximum-inscribed circle2d is ill-defined: the points do not surround an empty circle (" +
+      seen + "). An arc lets the inscribed circle grow without bound; probe the whole profile "
+      "or use the least-squares or minimum-zone circle.");
+}
+
+// Convex hull (counterclockwise, no collinear vertices) by Andrew's monotone chain with
+// CGAL's exact orientation predicate; indices into q.
+std::vector<int> convexHull2(const Points3& q) {
+  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+  std::vector<int> idx(q.size());
+  std::iota(idx.begin(), idx.end(), 0);
+  std::sort(idx.begin(), idx.end(), [&](int a, int b) {
+    return q[a].x() < q[b].x() || (q[a].x() == q[b].x() && q[a].y() < q[b].y());
+  });
+  idx.erase(std::unique(idx.begin(), idx.end(),
+                        [&](int a, int b) { return q[a].head<2>() == q[b].head<2>(); }),
+            idx.end());
+  if (idx.size() < 3) return idx;
+  auto P = [&](int i) { return K::Point_2(q[i].x(), q[i].y()); };
+  std::vector<int> h(2 * idx.size());
+  size_t k = 0;
+  for (size_t i = 0; i < idx.size(); ++i) {
+    while (k >= 2 && CGAL::orientation(P(h[k - 2]), P(h[k - 1]), P(idx[i])) != CGAL::LEFT_TURN) --k;
+    h[k++] = idx[i];
+  }
+  for (size_t i = idx.size() - 1, t = k + 1; i-- > 0;) {
+    while (k >= t && CGAL::orientation(P(h[k - 2]), P(h[k - 1]), P(idx[i])) != CGAL::LEFT_TURN) --k;
+    h[k++] = idx[i];
+  }
+  h.resize(k - 1);
+  return h;
+}
+
+// Minimum-width strip of the xy points: rotating calipers over the hull edges (the
+// optimal strip has one side through a hull edge; Toussaint 1983, "Solving geometric
+// problems with the rotating calipers"). Returns the unit direction of that edge.
+Vector2d minWidthDirection(const Points3& q) {
+  const std::vector<int> h = convexHull2(q);
+  if (h.size() < 2) return Vector2d::UnitX();
+  if (h.size() == 2) return (q[h[1]] - q[h[0]]).head<2>().normalized();
+  const size_t m = h.size();
+  auto P = [&](size_t i) { return Vector2d(q[h[i % m]].head<2>()); };
+  auto area = [&](size_t i, size_t j) {  // twice the area of (edge i, vertex j)
+    const Vector2d e = P(i + 1) - P(i);
+    const Vector2d v = P(j) - P(i);
+    return e.x() * v.y() - e.y() * v.x();
+  };
+  size_t j = 1;
+  double best = std::numeric_limits<double>::infinity();
+  Vector2d dir = Vector2d::UnitX();
+  for (size_t i = 0; i < m; ++i) {
+    if (j <= i) j = i + 1;
+    while (area(i, j + 1) > area(i, j)) ++j;
+    const double len = (P(i + 1) - P(i)).norm();
+    const double w = area(i, j) / len;
+    if (w < best) {
+      best = w;
+      dir = (P(i + 1) - P(i)) / len;
+    }
+  }
+  return dir;
+}
+
+// ------------------------------------------------------------------ starts
+
+// Own least-squares cylinder, used while fitLeastSquares is unavailable: of the three
+// principal axes the one whose projection is most circular (algebraic Kasa circle), then
+// Gauss-Newton on the orthogonal distances (axis model plus the radius; normal equations
+// are enough for a start).
+AxisModel ownCylinderStart(const Frame& f) {
+  const auto eig = scatter(f.q);
+  const int n = static_cast<int>(f.q.size());
+  double best_rms = std::numeric_limits<double>::infinity();
+  AxisModel m(&f.q, Vector3d::Zero(), eig.eigenvectors().col(2), f.size);
+  VectorXd r(n);
+  for (int k = 0; k < 3; ++k) {
+    const Vector3d a = eig.eigenvectors().col(k);
+    const Vector3d e1 = anyPerpendicular(a);
+    const Vector3d e2 = a.cross(e1);
+    // x^2 + y^2 = 2 cx x + 2 cy y + c0 in the plane perpendicular to a.
+    Eigen::Matrix3d AtA = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d Atb = Eigen::Vector3d::Zero();
+    for (int i = 0; i < n; ++i) {
+      const double x = e1.dot(f.q[i]), y = e2.dot(f.q[i]);
+      const Eigen::Vector3d row(2.0 * x, 2.0 * y, 1.0);
+      AtA += row * row.transpose();
+      Atb += row * (x * x + y * y);
+    }
+    const Eigen::Vector3d s = AtA.ldlt().solve(Atb);
+    if (!s.allFinite()) continue;
+    const AxisModel t(&f.q, s[0] * e1 + s[1] * e2, a, f.size);
+    evaluateAll(t, r, nullptr);
+    const double rms = std::sqrt((r.array() - r.mean()).square().sum() / n);
+    if (rms < best_rms) {
+      best_rms = rms;
+      m = t;
+    }
+  }
+  RowMatrix J(n, 4);
+  for (int it = 0; it < 30; ++it) {  // Gauss-Newton with the radius as 5th unknown
+    evaluateAll(m, r, &J);
+    const double rad = r.mean();
+    Eigen::Matrix<double, 5, 5> N = Eigen::Matrix<double, 5, 5>::Zero();
+    Eigen::Matrix<double, 5, 1> g = Eigen::Matrix<double, 5, 1>::Zero();
+    for (int i = 0; i < n; ++i) {
+      Eigen::Matrix<double, 5, 1> row;
+      row << J(i, 0), J(i, 1), J(i, 2), J(i, 3), -1.0;
+      N += row * row.transpose();
+      g -= row * (r[i] - rad);
+    }
+    const Eigen::Matrix<double, 5, 1> d = N.ldlt().solve(g);
+    if (!d.allFinite()) break;
+    const AxisModel t = m.stepped(d.head<4>());
+    VectorXd rt(n);
+    evaluateAll(t, rt, nullptr);
+    const double rms = std::sqrt((r.array() - rad).square().sum() / n);
+    const double rms_t = std::sqrt((rt.array() - rt.mean()).square().sum() / n);
+    if (!(rms_t < rms)) break;
+    m = t;
+    if (d.head<4>().norm() < 1e-12 * f.size) break;
+  }
+  return m;
+}
+
+AxisModel cylinderStart(const Frame& f, const Points3& points) {
+  try {
+    const FitResult ls = fitLeastSquares(ElementKind::Cylinder, points);
+    const Element& e = ls.element;
+    if (e.kind == ElementKind::Cylinder && e.position_mm.allFinite() && e.direction.allFinite() &&
+        e.direction.norm() > 0.5)
+      return AxisModel(&f.q, e.position_mm - f.origin, e.direction, f.size);
+  } catch (const GeometryError&) {
+    // Not available or not applicable here: the own start below is as good a start.
+  }
+  return ownCylinderStart(f);
+}
+
+// ------------------------------------------------------------------ results
+
+// Indices whose residual is within tol of lo or hi (the zone boundaries).
+std::vector<int> supportOf(const VectorXd& r, Goal goal, double tol) {
+  const double hi = r.maxCoeff(), lo = r.minCoeff();
+  std::vector<int> s;
+  for (int i = 0; i < r.size(); ++i)
+    if ((goal != Goal::Inner && r[i] >= hi - tol) || (goal != Goal::Outer && r[i] <= lo + tol))
+      s.push_back(i);
+  return s;
+}
+
+// Final verification: the SLP certificate (no first-order improvement of the linearised
+// problem; see the alternation note at the top). Throws when the fit did not converge.
+void certify(const SlpOutcome& o, FitMethod method, ElementKind kind) {
+  if (!o.converged)
+    throw GeometryError(methodLabel(method) + " " + std::string(elementName(kind)) +
+                        " did not converge (" + std::to_string(o.iterations) +
+                        " iterations); the points are probably far from the element's shape "
+                        "(check for outliers or a wrong element kind)");
+}
+
+FitResult finish(const Element& e, FitMethod method, const Points3& points, int k,
+                 std::vector<int> support, int iterations) {
+  FitResult res;
+  res.element = e;
+  res.method = method;
+  res.iterations = iterations;
+  fillResiduals(res, points, k);
+  std::sort(support.begin(), support.end());
+  res.support_points = std::move(support);
+  return res;
+}
+
+// Number of free parameters reported in dof (elements.hpp order).
+int freeParameters(ElementKind kind) {
+  switch (kind) {
+    case ElementKind::Line2D: return 2;
+    case ElementKind::Line3D: return 4;
+    case ElementKind::Plane: return 3;
+    case ElementKind::Circle2D: return 3;
+    case ElementKind::Sphere: return 4;
+    case ElementKind::Cylinder: return 5;
+    default: return 0;
+  }
+}
+
+// Start trust box: the zone width (the optimum is within about a width of a good start in
+// the mm-scaled parameters), at least a tiny fraction of the size.
+double startBox(const Frame& f, double width) { return std::max(width, 1e-7 * f.size); }
+
+// ---- circle / sphere (centre models)
+
+template <int D>
+FitResult centreFit(ElementKind kind, FitMethod method, const Points3& points, const Frame& f) {
+  using Vec = Eigen::Matrix<double, D, 1>;
+  CentreModel<D> model;
+  model.q = &f.q;
+  const Goal goal = method == FitMethod::MinimumZone ? Goal::Zone
+                    : method == FitMethod::MaximumInscribed ? Goal::Inner
+                                                            : Goal::Outer;
+  double box = 0.0;
+  if constexpr (D == 2) {
+    if (method == FitMethod::MinimumCircumscribed) model.c = minCircleCentre(f);
+    else if (method == FitMethod::MaximumInscribed) model.c = maxInscribedCircleCentre(f);
+    else model.c = annulusCentre<2>(f);
+  } else {
+    model.c = method == FitMethod::MinimumCircumscribed ? minSphereCentre(f) : annulusCentre<3>(f);
+  }
+  {
+    VectorXd r(f.q.size());
+    evaluateAll(model, r, nullptr);
+    // Exact starts: only a polish/certificate is expected, except MI sphere (from the
+    // annulus centre) which moves by up to about the zone width.
+    box = startBox(f, r.maxCoeff() - r.minCoeff());
+  }
+  const SlpOutcome o = runSlp(model, goal, f, box, 200);
+  const Vec c = model.c;
+  if (method == FitMethod::MaximumInscribed && (!o.converged || c.norm() > f.size)) {
+    throw GeometryError(
+        "maximum-inscribed " + std::string(elementName(kind)) +
+        " is ill-defined: the points do not surround the centre (a cap or partial surface lets "
+        "the inscribed sphere grow without bound). Probe points in every direction from the "
+        "centre, or use the least-squares or minimum-zone sphere.");
+  }
+  certify(o, method, kind);
+  VectorXd r(f.q.size());
+  evaluateAll(model, r, nullptr);
+  Element e;
+  e.kind = kind;
+  e.position_mm = f.origin;
+  e.position_mm.template head<D>() += c;
+  const double lo = r.minCoeff(), hi = r.maxCoeff();
+  e.radius_mm = goal == Goal::Zone ? 0.5 * (lo + hi) : goal == Goal::Outer ? hi : lo;
+  e.direction = Vector3d::UnitZ();
+  return finish(e, method, points, freeParameters(kind), supportOf(r, goal, f.support), o.iterations);
+}
+
+// ---- axis models (cylinder, line3d)
+
+FitResult axisFit(ElementKind kind, FitMethod method, const Points3& points, const Frame& f) {
+  const Goal goal = kind == ElementKind::Line3D || method == FitMethod::MinimumCircumscribed
+                        ? Goal::Outer
+                        : method == FitMethod::MaximumInscribed ? Goal::Inner
+                                                                : Goal::Zone;
+  AxisModel model = kind == ElementKind::Line3D
+                        ? AxisModel(&f.q, Vector3d::Zero(), scatter(f.q).eigenvectors().col(2), f.size)
+                        : cylinderStart(f, points);
+  VectorXd r(f.q.size());
+  evaluateAll(model, r, nullptr);
+  const double width = kind == ElementKind::Line3D ? r.maxCoeff() : r.maxCoeff() - r.minCoeff();
+  const SlpOutcome o = runSlp(model, goal, f, startBox(f, width), 300);
+  if (method == FitMethod::MaximumInscribed && (!o.converged || model.p0.norm() > f.size))
+    throw GeometryError(
+        "maximum-inscribed cylinder is ill-defined: the points do not surround the axis (a "
+        "partial cylinder, less than half way round, lets the inscribed cylinder grow without "
+        "bound). Probe all the way round, or use the least-squares or minimum-zone cylinder.");
+  certify(o, method, kind);
+  evaluateAll(model, r, nullptr);
+  Element e;
+  e.kind = kind;
+  e.position_mm = f.origin + model.p0;
+  e.direction = canonical(model.a);
+  const double lo = r.minCoeff(), hi = r.maxCoeff();
+  if (kind == ElementKind::Cylinder)
+    e.radius_mm = goal == Goal::Zone ? 0.5 * (lo + hi) : goal == Goal::Outer ? hi : lo;
+  return finish(e, method, points, freeParameters(kind), supportOf(r, goal, f.support), o.iterations);
+}
+
+// ---- plane and line2d (zone between two parallel planes / lines)
+
+FitResult planeFit(const Points3& points, const Frame& f) {
+  PlaneModel model(&f.q, scatter(f.q).eigenvectors().col(0), f.size);
+  VectorXd r(f.q.size());
+  evaluateAll(model, r, nullptr);
+  const SlpOutcome o = runSlp(model, Goal::Zone, f, startBox(f, r.maxCoeff() - r.minCoeff()), 200);
+  certify(o, FitMethod::MinimumZone, ElementKind::Plane);
+  evaluateAll(model, r, nullptr);
+  const double mid = 0.5 * (r.maxCoeff() + r.minCoeff());
+  Element e;
+  e.kind = ElementKind::Plane;
+  e.direction = canonical(model.n);
+  e.position_mm = f.origin + model.n * mid;  // foot of the centroid on the mid plane
+  return finish(e, FitMethod::MinimumZone, points, 3, supportOf(r, Goal::Zone, f.support), o.iterations);
+}
+
+FitResult line2dFit(const Points3& points, const Frame& f) {
+  Line2Model model;
+  model.q = &f.q;
+  model.L = f.size;
+  model.d = minWidthDirection(f.q);
+  VectorXd r(f.q.size());
+  evaluateAll(model, r, nullptr);
+  const SlpOutcome o = runSlp(model, Goal::Zone, f, 1e-7 * f.size, 100);  // certificate
+  certify(o, FitMethod::MinimumZone, ElementKind::Line2D);
+  evaluateAll(model, r, nullptr);
+  const double mid = 0.5 * (r.maxCoeff() + r.minCoeff());
+  Element e;
+  e.kind = ElementKind::Line2D;
+  e.direction = canonical(Vector3d(model.d.x(), model.d.y(), 0.0));
+  e.position_mm = f.origin + Vector3d(model.normal().x(), model.normal().y(), 0.0) * mid;
+  return finish(e, FitMethod::MinimumZone, points, 2, supportOf(r, Goal::Zone, f.support), o.iterations);
+}
+
+}  // namespace
+
+FitResult fitMinimumZone(ElementKind kind, const Points3& points) {
+  const FitMethod method = FitMethod::MinimumZone;
+  requireKind(kind, method,
+              {ElementKind::Line2D, ElementKind::Line3D, ElementKind::Plane, ElementKind::Circle2D,
+               ElementKind::Sphere, ElementKind::Cylinder});
+  const Frame f = prepare(kind, method, points);
+  switch (kind) {
+    case ElementKind::Line2D: return line2dFit(points, f);
+    case ElementKind::Plane: return planeFit(points, f);
+    case ElementKind::Circle2D: return centreFit<2>(kind, method, points, f);
+    case ElementKind::Sphere: return centreFit<3>(kind, method, points, f);
+    default: return axisFit(kind, method, points, f);
+  }
+}
+
+FitResult fitMaximumInscribed(ElementKind kind, const Points3& points) {
+  const FitMethod method = FitMethod::MaximumInscribed;
+  requireKind(kind, method, {ElementKind::Circle2D, ElementKind::Sphere, ElementKind::Cylinder});
+  const Frame f = prepare(kind, method, points);
+  if (kind == ElementKind::Circle2D) return centreFit<2>(kind, method, points, f);
+  if (kind == ElementKind::Sphere) return centreFit<3>(kind, method, points, f);
+  return axisFit(kind, method, points, f);
+}
+
+FitResult fitMinimumCircumscribed(ElementKind kind, const Points3& points) {
+  const FitMethod method = FitMethod::MinimumCircumscribed;
+  requireKind(kind, method, {ElementKind::Circle2D, ElementKind::Sphere, ElementKind::Cylinder});
+  const Frame f = prepare(kind, method, points);
+  if (kind == ElementKind::Circle2D) return centreFit<2>(kind, method, points, f);
+  if (kind == ElementKind::Sphere) return centreFit<3>(kind, method, points, f);
+  return axisFit(kind, method, points, f);
 }
 
 }  // namespace probeloop::geometry
