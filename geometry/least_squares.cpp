@@ -1321,7 +1321,8 @@ LmRun<Model> fitAxisElement(const Points3& pts, const Moments& m, const Axes& ax
   }
   if (runs.empty()) return LmRun<Model>{};
   const LmRun<Model> best = pickSolution(runs, sp.size(), size);
-  if (!subsampled) return best;  return levenbergMarquardt(full, best.state, o.max_iterations, red);
+  if (!subsampled) return best;
+  return levenbergMarquardt(full, best.state, o.max_iterations, red);
 }
 
 // Why an axis fit is ill-determined: along-axis extent or angular sector of the points.
