@@ -20,6 +20,7 @@
 #include "planner/sphere_cycle.hpp"
 #include "report/scene.hpp"
 #include "sim/rigid_campaign.hpp"
+#include "sim/virtual_machine.hpp"
 
 using namespace probeloop;
 namespace fs = std::filesystem;
@@ -93,6 +94,26 @@ int cmdSynth(const std::string& manifest_file, const std::string& truth_file,
   std::printf("Synthesised %d cycles x %zu points (seed %llu) into %s: sphere_probe.log (LinuxCNC), "
               "sphere_probe_dprnt.txt (Fanuc), points.csv, truth.json\n",
               m.cycles, m.points.size(), static_cast<unsigned long long>(seed), out_dir.c_str());
+  return 0;
+}
+
+int cmdSimulate(const std::string& program_file, const std::string& machine_file,
+                const std::string& part_file, const std::string& truth_file, const std::string& out_dir,
+                std::uint64_t seed) {
+  const auto machine = parts::loadMachine(machine_file);
+  const auto part = parts::loadSphereArtifact(part_file);
+  const auto truth = sim::loadMachineTruth(truth_file);
+  const auto s = sim::simulateProgram(program_file, readFile(program_file), machine, part, truth, seed);
+  const std::string log_file = fs::path(s.log_name).filename().string();
+  writeFileAtomic(join(out_dir, log_file), s.log_text);
+  writeFileAtomic(join(out_dir, "points.csv"), s.points_csv);
+  writeFileAtomic(join(out_dir, "inputs.csv"), s.inputs_csv);
+  writeFileAtomic(join(out_dir, "truth.json"), s.truth_json);
+  std::printf("Simulated %s on %s (seed %llu): %ld blocks, %ld probe events, %.1f h of machine time\n",
+              program_file.c_str(), machine.name.c_str(), static_cast<unsigned long long>(seed), s.blocks,
+              s.probe_events, s.end_time_s / 3600.0);
+  std::printf("  wrote %s (controller log), points.csv, inputs.csv, truth.json in %s\n", log_file.c_str(),
+              out_dir.c_str());
   return 0;
 }
 
@@ -220,6 +241,15 @@ int main(int argc, char** argv) {
   syn->add_option("--out", out, "output folder")->capture_default_str();
   syn->add_option("--seed", seed, "random seed")->capture_default_str();
 
+  std::string program, part;
+  auto* simc = app.add_subcommand("simulate", "Run an emitted program on a virtual machine with known error effects");
+  simc->add_option("program", program, "G-code program (.ngc LinuxCNC, .nc Fanuc macro B)")->required()->check(CLI::ExistingFile);
+  simc->add_option("--machine", machine, "machine description (YAML)")->required()->check(CLI::ExistingFile);
+  simc->add_option("--part", part, "the sphere artifact on the table (YAML)")->required()->check(CLI::ExistingFile);
+  simc->add_option("--truth", truth, "the machine's error effects (YAML, kind: machine_truth)")->required()->check(CLI::ExistingFile);
+  simc->add_option("--out", out, "output folder")->capture_default_str();
+  simc->add_option("--seed", seed, "random seed")->capture_default_str();
+
   auto* ev = app.add_subcommand("evaluate", "Location errors of the C axis from probe logs or points CSV");
   ev->add_option("points", points, "LinuxCNC log, Fanuc DPRNT output or points CSV")->required()->check(CLI::ExistingFile);
   ev->add_option("--manifest", manifest, "plan manifest (plan.json)")->required()->check(CLI::ExistingFile);
@@ -256,6 +286,7 @@ int main(int argc, char** argv) {
     if (*plan) return cmdPlan(artifact, machine, out, dialect);
     if (*res) return cmdResolution(artifact, machine, step_um);
     if (*syn) return cmdSynth(manifest, truth, out, seed);
+    if (*simc) return cmdSimulate(program, machine, part, truth, out, seed);
     if (*fit) return cmdFit(fa);
     if (*ev) return cmdEvaluate(points, manifest, out, format, free_radius, scene, exaggeration);
   } catch (const std::exception& e) {

@@ -1,5 +1,7 @@
 #include "parts/yaml_reader.hpp"
 
+#include "core/csv.hpp"
+
 #include <fstream>
 #include <stdexcept>
 
@@ -79,6 +81,19 @@ std::vector<double> YamlMap::quantityList(const std::string& key, Dimension dim)
     }
   }
   return out;
+}
+
+double YamlMap::number(const std::string& key) {
+  const YAML::Node n = node(key);
+  double v = 0;
+  if (!n.IsScalar() || !parseFiniteNumber(n.Scalar(), v))
+    fail(key, "expected a finite number, found '" + (n.IsScalar() ? n.Scalar() : "non-scalar") + "'");
+  return v;
+}
+
+double YamlMap::numberOr(const std::string& key, double fallback) {
+  allowed_.insert(key);
+  return has(key) ? number(key) : fallback;
 }
 
 int YamlMap::integer(const std::string& key) {

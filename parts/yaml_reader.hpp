@@ -23,6 +23,8 @@ class YamlMap {
   double quantity(const std::string& key, Dimension dim);
   double quantityOr(const std::string& key, Dimension dim, double fallback);
   std::vector<double> quantityList(const std::string& key, Dimension dim);
+  double number(const std::string& key);  // a plain finite number (unit in the key's name)
+  double numberOr(const std::string& key, double fallback);
   int integer(const std::string& key);
   int integerOr(const std::string& key, int fallback);
   bool boolean(const std::string& key);

@@ -1,0 +1,892 @@
+#include "gcode/interpreter.hpp"
+
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <optional>
+#include <variant>
+#include <algorithm>
+
+#include "core/error.hpp"
+
+namespace probeloop::gcode {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+std::string upper(std::string s) {
+  for (auto& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+std::string lower(std::string s) {
+  for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+// Messages that act (LinuxCNC active comments); other comments are ignored.
+bool isActiveComment(const std::string& body, ProgramDialect d) {
+  if (d != ProgramDialect::LinuxCnc) return false;
+  const std::string u = upper(body);
+  for (const char* k : {"LOGOPEN", "LOGAPPEND", "LOGCLOSE", "LOG", "ABORT", "MSG", "DEBUG", "PRINT"}) {
+    const std::string key = k;
+    if (u.compare(0, key.size(), key) == 0 &&
+        (u.size() == key.size() || u[key.size()] == ',' || key == "LOGCLOSE"))
+      return true;
+  }
+  return false;
+}
+
+// An error raised by the program itself (alarm, ABORT, probe without contact): the
+// controller stops there.
+[[noreturn]] void stop(const std::string& file, int line, const std::string& what) {
+  throw SafetyError(file + ":" + std::to_string(line) + ": " + what);
+}
+
+}  // namespace
+
+Interpreter::Interpreter(ProgramDialect dialect, std::string file_name, const std::string& text)
+    : dialect_(dialect), file_(std::move(file_name)) {
+  int number = 0;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    std::string raw = text.substr(start, end - start);
+    ++number;
+    start = end + 1;
+    if (!raw.empty() && raw.back() == '\r') raw.pop_back();
+    Line l;
+    l.number = number;
+    bool in_name = false;
+    for (std::size_t i = 0; i < raw.size(); ++i) {
+      const char c = raw[i];
+      if (c == '(') {
+        const std::size_t close = raw.find(')', i);
+        if (close == std::string::npos)
+          throw InputError(file_, number, "comment '(' is not closed on this line");
+        const std::string body = raw.substr(i + 1, close - i - 1);
+        l.comment = body;
+        if (isActiveComment(body, dialect_)) {
+          if (!l.message.empty())
+            throw InputError(file_, number, "two active comments on one line; the simulator takes one");
+          l.message = body;
+        }
+        i = close;
+        continue;
+      }
+      if (c == ';' && dialect_ == ProgramDialect::LinuxCnc) break;
+      if (std::isspace(static_cast<unsigned char>(c))) continue;
+      if (c == '<') in_name = true;
+      if (c == '>') in_name = false;
+      l.code += in_name ? static_cast<char>(std::tolower(static_cast<unsigned char>(c)))
+                        : static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    }
+    if (l.code == "%") l.code.clear();  // Fanuc tape start/end
+    if (!l.code.empty() || !l.message.empty()) lines_.push_back(l);
+    if (end == text.size()) break;
+  }
+}
+
+double Interpreter::parameter(int number) const {
+  const auto it = params_.find(number);
+  return it == params_.end() ? 0.0 : it->second;
+}
+double Interpreter::namedParameter(const std::string& name) const {
+  const auto it = named_.find(lower(name));
+  return it == named_.end() ? 0.0 : it->second;
+}
+
+// One run of the program: cursor, modal state and control flow.
+class Execution {
+ public:
+  Execution(Interpreter& in, MachineInterface& m) : in_(in), m_(m), pos_(m.start()) {}
+
+  InterpreterResult run(long max_blocks) {
+    buildJumps();
+    InterpreterResult r;
+    pc_ = 0;
+    while (pc_ < in_.lines_.size()) {
+      if (++r.blocks_executed > max_blocks)
+        fail("the program executed " + std::to_string(max_blocks) +
+             " blocks without ending; an endless loop?");
+      const auto& line = in_.lines_[pc_];
+      line_ = line.number;
+      std::size_t next = pc_ + 1;
+      try {
+        if (executeLine(line, next)) {
+          r.ended = true;
+          return r;
+        }
+      } catch (const SafetyError& e) {
+        const std::string w = e.what();
+        if (w.rfind(in_.file_ + ":", 0) == 0) throw;
+        throw SafetyError(in_.file_ + ":" + std::to_string(line_) + ": " + w);
+      } catch (const InputError& e) {
+        if (e.line() > 0 || !e.file().empty()) throw;
+        fail(e.what());
+      }
+      pc_ = next;
+    }
+    return r;
+  }
+
+ private:
+  Interpreter& in_;
+  MachineInterface& m_;
+  std::size_t pc_ = 0;
+  int line_ = 0;
+
+  // Modal state.
+  double motion_ = 0;  // 0, 1, 2, 3, 38.2, 38.3, 80 (none)
+  bool absolute_ = true;
+  double feed_ = 0;
+  int wcs_ = 1;
+  std::array<std::array<double, 5>, 7> offsets_{};  // [1..6] x y z b c
+  double tool_length_ = 0;
+  int tool_in_spindle_ = 0, tool_selected_ = 0;
+  double spindle_rpm_ = 0;
+  MachinePosition pos_;  // gauge line, machine coordinates
+  bool log_open_ = false;
+  bool seen_program_number_ = false;
+
+  // Control flow.
+  std::map<std::size_t, std::size_t> jump_;       // line index -> matching end / next branch
+  std::map<std::size_t, std::size_t> loop_back_;  // end of loop -> its head
+  std::map<int, std::size_t> labels_;             // Fanuc N labels
+
+  [[noreturn]] void fail(const std::string& m) const { throw InputError(in_.file_, line_, m); }
+
+  // ---------------------------------------------------------------------------------
+  // Expressions
+
+  struct Cursor {
+    const std::string& s;
+    std::size_t i = 0;
+    bool end() const { return i >= s.size(); }
+    char peek() const { return end() ? '\0' : s[i]; }
+    bool take(const std::string& t) {
+      if (s.compare(i, t.size(), t) == 0) {
+        i += t.size();
+        return true;
+      }
+      return false;
+    }
+  };
+
+  double number(Cursor& c) {
+    const std::size_t b = c.i;
+    while (!c.end() && (std::isdigit(static_cast<unsigned char>(c.peek())) || c.peek() == '.')) ++c.i;
+    if (c.i == b) fail("expected a number at column " + std::to_string(b + 1) + " of '" + c.s + "'");
+    const std::string t = c.s.substr(b, c.i - b);
+    if (t == "." || std::count(t.begin(), t.end(), '.') > 1) fail("'" + t + "' is not a number");
+    return std::stod(t);
+  }
+
+  double readParam(Cursor& c) {  // after '#'
+    if (c.peek() == '<') {
+      const std::size_t close = c.s.find('>', c.i);
+      if (close == std::string::npos) fail("named parameter '#<' is not closed");
+      const std::string name = c.s.substr(c.i + 1, close - c.i - 1);
+      c.i = close + 1;
+      const auto it = in_.named_.find(name);
+      if (it == in_.named_.end()) fail("named parameter #<" + name + "> is read before it is set");
+      return it->second;
+    }
+    return in_.parameter(paramNumber(c));
+  }
+
+  int paramNumber(Cursor& c) {
+    const double v = c.peek() == '[' ? bracket(c) : (c.peek() == '#' ? (++c.i, readParam(c)) : number(c));
+    const double r = std::round(v);
+    if (std::fabs(v - r) > 1e-6 || r < 0 || r > 99999) fail("parameter number " + std::to_string(v) + " is not valid");
+    return static_cast<int>(r);
+  }
+
+  double bracket(Cursor& c) {
+    if (!c.take("[")) fail("expected '[' at column " + std::to_string(c.i + 1));
+    const double v = expression(c);
+    if (!c.take("]")) fail("expected ']' at column " + std::to_string(c.i + 1) + " of '" + c.s + "'");
+    return v;
+  }
+
+  double primary(Cursor& c) {
+    if (c.take("-")) return -primary(c);
+    if (c.take("+")) return primary(c);
+    if (c.peek() == '[') return bracket(c);
+    if (c.take("#")) return readParam(c);
+    if (std::isdigit(static_cast<unsigned char>(c.peek())) || c.peek() == '.') return number(c);
+    static const char* functions[] = {"ABS", "ACOS", "ASIN", "ATAN", "COS", "EXP", "FIX", "FUP",
+                                      "LN", "ROUND", "SIN", "SQRT", "TAN"};
+    for (const char* f : functions) {
+      if (c.take(f)) {
+        const std::string fn = f;
+        const double a = bracket(c);
+        if (fn == "ATAN") {
+          if (c.take("/")) return std::atan2(a, bracket(c)) * 180.0 / kPi;
+          if (in_.dialect_ == ProgramDialect::LinuxCnc) fail("ATAN needs the form ATAN[y]/[x]");
+          return std::atan(a) * 180.0 / kPi;
+        }
+        if (fn == "ABS") return std::fabs(a);
+        if (fn == "ACOS" || fn == "ASIN") {
+          if (a < -1 || a > 1) fail(fn + " of " + std::to_string(a) + " is undefined");
+          return (fn == "ACOS" ? std::acos(a) : std::asin(a)) * 180.0 / kPi;
+        }
+        if (fn == "COS") return std::cos(a * kPi / 180.0);
+        if (fn == "SIN") return std::sin(a * kPi / 180.0);
+        if (fn == "TAN") return std::tan(a * kPi / 180.0);
+        if (fn == "EXP") return std::exp(a);
+        if (fn == "FIX") return std::floor(a);
+        if (fn == "FUP") return std::ceil(a);
+        if (fn == "ROUND") return std::round(a);
+        if (fn == "LN") {
+          if (a <= 0) fail("LN of a non-positive value");
+          return std::log(a);
+        }
+        if (a < 0) fail("SQRT of a negative value");
+        return std::sqrt(a);
+      }
+    }
+    fail("unexpected '" + std::string(1, c.peek()) + "' at column " + std::to_string(c.i + 1) +
+         " of '" + c.s + "' (expected a number, #parameter, [expression] or function)");
+  }
+
+  double power(Cursor& c) {
+    double v = primary(c);
+    while (c.take("**")) v = std::pow(v, primary(c));
+    return v;
+  }
+  double product(Cursor& c) {
+    double v = power(c);
+    for (;;) {
+      if (c.s.compare(c.i, 2, "**") != 0 && c.take("*")) v *= power(c);
+      else if (c.take("/")) {
+        const double d = power(c);
+        if (d == 0) fail("division by zero");
+        v /= d;
+      } else if (c.take("MOD")) {
+        const double d = power(c);
+        if (d == 0) fail("MOD by zero");
+        v = v - d * std::floor(v / d);
+      } else return v;
+    }
+  }
+  double sum(Cursor& c) {
+    double v = product(c);
+    for (;;) {
+      if (c.take("+")) v += product(c);
+      else if (c.take("-")) v -= product(c);
+      else return v;
+    }
+  }
+  double comparison(Cursor& c) {
+    double v = sum(c);
+    for (;;) {
+      if (c.take("EQ")) v = v == sum(c);
+      else if (c.take("NE")) v = v != sum(c);
+      else if (c.take("GT")) v = v > sum(c);
+      else if (c.take("GE")) v = v >= sum(c);
+      else if (c.take("LT")) v = v < sum(c);
+      else if (c.take("LE")) v = v <= sum(c);
+      else return v;
+    }
+  }
+  double expression(Cursor& c) {
+    double v = comparison(c);
+    for (;;) {
+      if (c.take("AND")) v = (v != 0) && (comparison(c) != 0);
+      else if (c.take("OR")) v = (v != 0) || (comparison(c) != 0);
+      else if (c.take("XOR")) v = (v != 0) != (comparison(c) != 0);
+      else return v;
+    }
+  }
+
+  // A word's value: a number, a parameter, or a bracketed expression, with a sign.
+  double wordValue(Cursor& c) {
+    if (c.take("-")) return -wordValue(c);
+    if (c.take("+")) return wordValue(c);
+    if (c.peek() == '[') return bracket(c);
+    if (c.take("#")) return readParam(c);
+    return number(c);
+  }
+
+  // ---------------------------------------------------------------------------------
+  // Control structures, resolved once before running.
+
+  struct OWord {
+    std::string label, keyword;
+    std::size_t rest = 0;  // index in code after the keyword
+  };
+  std::optional<OWord> oword(const std::string& code) const {
+    if (in_.dialect_ != ProgramDialect::LinuxCnc || code.empty() || code[0] != 'O') return std::nullopt;
+    std::size_t i = 1;
+    if (i < code.size() && code[i] == '<') {
+      i = code.find('>', i);
+      if (i == std::string::npos) return std::nullopt;
+      ++i;
+    } else {
+      while (i < code.size() && std::isdigit(static_cast<unsigned char>(code[i]))) ++i;
+    }
+    OWord o;
+    o.label = code.substr(1, i - 1);
+    std::size_t k = i;
+    while (k < code.size() && std::isalpha(static_cast<unsigned char>(code[k]))) ++k;
+    o.keyword = code.substr(i, k - i);
+    o.rest = k;
+    return o;
+  }
+
+  void buildJumps() {
+    const auto& L = in_.lines_;
+    std::vector<std::pair<std::string, std::size_t>> stack;  // keyword@label, line index
+    std::map<std::size_t, std::vector<std::size_t>> branches;  // if -> elseif/else lines
+    std::vector<std::pair<int, std::size_t>> fanuc_do;
+    for (std::size_t k = 0; k < L.size(); ++k) {
+      line_ = L[k].number;
+      const std::string& code = L[k].code;
+      if (auto o = oword(code)) {
+        static const std::vector<std::string> unsupported{"SUB", "ENDSUB", "CALL", "RETURN",
+                                                          "REPEAT", "ENDREPEAT", "DO", "BREAK", "CONTINUE"};
+        for (const auto& u : unsupported)
+          if (o->keyword == u)
+            fail("o-word '" + lower(u) + "' is not modelled by the simulator (supported: while, "
+                 "endwhile, if, elseif, else, endif)");
+        if (o->keyword == "WHILE" || o->keyword == "IF") {
+          stack.push_back({o->keyword + "@" + o->label, k});
+        } else if (o->keyword == "ELSEIF" || o->keyword == "ELSE") {
+          if (stack.empty() || stack.back().first != "IF@" + o->label)
+            fail("o" + lower(o->label) + " " + lower(o->keyword) + " without a matching if");
+          branches[stack.back().second].push_back(k);
+        } else if (o->keyword == "ENDWHILE" || o->keyword == "ENDIF") {
+          const std::string want = (o->keyword == "ENDWHILE" ? "WHILE@" : "IF@") + o->label;
+          if (stack.empty() || stack.back().first != want)
+            fail("o" + lower(o->label) + " " + lower(o->keyword) + " without a matching " +
+                 (o->keyword == "ENDWHILE" ? "while" : "if"));
+          const std::size_t head = stack.back().second;
+          stack.pop_back();
+          if (o->keyword == "ENDWHILE") {
+            jump_[head] = k;
+            loop_back_[k] = head;
+          } else {
+            // Chain: if -> first branch -> next branch ... -> endif; each branch's end jumps
+            // to endif (recorded as the branch line -> endif in loop_back_ with a marker).
+            std::size_t prev = head;
+            for (std::size_t b : branches[head]) {
+              jump_[prev] = b;
+              prev = b;
+            }
+            jump_[prev] = k;
+            for (std::size_t b : branches[head]) endif_of_[b] = k;
+          }
+        } else {
+          fail("o-word keyword '" + lower(o->keyword) + "' is not modelled by the simulator");
+        }
+        continue;
+      }
+      if (in_.dialect_ == ProgramDialect::FanucMacroB) {
+        std::size_t i = 0;
+        if (code[0] == 'N') {
+          i = 1;
+          while (i < code.size() && std::isdigit(static_cast<unsigned char>(code[i]))) ++i;
+          if (i > 1) {
+            const int n = std::stoi(code.substr(1, i - 1));
+            if (labels_.count(n)) fail("label N" + std::to_string(n) + " appears twice");
+            labels_[n] = k;
+          }
+        }
+        const std::string rest = code.substr(i);
+        if (rest.rfind("WHILE", 0) == 0) {
+          const std::size_t d = rest.rfind("DO");
+          if (d == std::string::npos) fail("WHILE without DOm");
+          fanuc_do.push_back({std::stoi(rest.substr(d + 2)), k});
+        } else if (rest.rfind("END", 0) == 0 && rest.size() > 3 &&
+                   std::isdigit(static_cast<unsigned char>(rest[3]))) {
+          const int m = std::stoi(rest.substr(3));
+          if (fanuc_do.empty() || fanuc_do.back().first != m)
+            fail("END" + std::to_string(m) + " without a matching WHILE ... DO" + std::to_string(m));
+          jump_[fanuc_do.back().second] = k;
+          loop_back_[k] = fanuc_do.back().second;
+          fanuc_do.pop_back();
+        }
+      }
+    }
+    if (!stack.empty()) {
+      line_ = L[stack.back().second].number;
+      fail("this block is never closed (" + lower(stack.back().first) + ")");
+    }
+    if (!fanuc_do.empty()) {
+      line_ = L[fanuc_do.back().second].number;
+      fail("WHILE ... DO" + std::to_string(fanuc_do.back().first) + " is never closed by END");
+    }
+  }
+  std::map<std::size_t, std::size_t> endif_of_;  // elseif/else line -> its endif
+
+  // Returns true when the program ends.
+  bool executeLine(const Interpreter::Line& line, std::size_t& next) {
+    if (!line.message.empty()) activeComment(line.message);
+    const std::string& code = line.code;
+    if (code.empty()) return false;
+    if (auto o = oword(code)) return controlLinux(*o, code, next), false;
+    if (in_.dialect_ == ProgramDialect::FanucMacroB) {
+      std::size_t i = 0;
+      if (code[0] == 'N') {
+        i = 1;
+        while (i < code.size() && std::isdigit(static_cast<unsigned char>(code[i]))) ++i;
+      }
+      const std::string rest = code.substr(i);
+      if (rest.empty()) return false;
+      if (rest[0] == 'O') {
+        // The program number; a second one would start another program (a subprogram).
+        if (seen_program_number_) fail("a second program number '" + rest + "': subprograms are not modelled");
+        seen_program_number_ = true;
+        return false;
+      }
+      if (controlFanuc(rest, next)) return false;
+      return block(rest);
+    }
+    return block(code);
+  }
+
+  void controlLinux(const OWord& o, const std::string& code, std::size_t& next) {
+    Cursor c{code, o.rest};
+    const auto k = pc_;
+    if (o.keyword == "WHILE") {
+      if (!condition(c)) next = jump_.at(k) + 1;
+    } else if (o.keyword == "ENDIF") {
+    } else if (o.keyword == "ENDWHILE") {
+      next = loop_back_.at(k);
+    } else if (o.keyword == "IF") {
+      if (!condition(c)) {
+        next = jump_.at(k);  // to the first elseif/else or the endif
+        branch_target_ = next;
+      }
+    } else if (o.keyword == "ELSEIF" || o.keyword == "ELSE") {
+      // Reached by a jump from a failed condition: test this branch. Reached by falling
+      // out of a taken branch: skip to the endif.
+      if (branch_target_ == k) {
+        branch_target_ = kNone;
+        if (o.keyword == "ELSE" || condition(c)) return;
+        next = jump_.at(k);
+        branch_target_ = next;
+        return;
+      }
+      next = endif_of_.at(k);
+    }
+    (void)code;
+  }
+  static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
+  std::size_t branch_target_ = kNone;
+
+  bool condition(Cursor& c) {
+    if (c.peek() != '[') fail("expected a [condition]");
+    const double v = bracket(c);
+    if (!c.end()) fail("unexpected '" + c.s.substr(c.i) + "' after the condition");
+    return v != 0;
+  }
+
+  // Fanuc control words; true when the line was one.
+  bool controlFanuc(const std::string& rest, std::size_t& next) {
+    Cursor c{rest, 0};
+    if (c.take("WHILE")) {
+      const double v = bracket(c);
+      if (!c.take("DO")) fail("WHILE [..] must be followed by DOm");
+      if (v == 0) next = jump_.at(pc_) + 1;
+      return true;
+    }
+    if (c.take("END") && !c.end() && std::isdigit(static_cast<unsigned char>(c.peek()))) {
+      next = loop_back_.at(pc_);
+      return true;
+    }
+    c.i = 0;
+    if (c.take("GOTO")) {
+      next = label(static_cast<int>(std::lround(wordValue(c))));
+      return true;
+    }
+    if (c.take("IF")) {
+      const double v = bracket(c);
+      if (c.take("GOTO")) {
+        const int n = static_cast<int>(std::lround(wordValue(c)));
+        if (v != 0) next = label(n);
+        return true;
+      }
+      if (c.take("THEN")) {
+        if (v != 0) {
+          const std::string stmt = rest.substr(c.i);
+          if (stmt.empty() || stmt[0] != '#') fail("IF ... THEN takes an assignment (#i=...)");
+          assign(stmt);
+        }
+        return true;
+      }
+      fail("IF [..] must be followed by GOTO n or THEN");
+    }
+    if (rest == "POPEN") {
+      m_.openLog("");
+      m_.log("%");
+      log_open_ = true;
+      return true;
+    }
+    if (rest == "PCLOS") {
+      if (log_open_) m_.log("%");
+      m_.closeLog();
+      log_open_ = false;
+      return true;
+    }
+    if (rest.rfind("DPRNT[", 0) == 0) {
+      if (!log_open_) fail("DPRNT before POPEN");
+      m_.log(dprnt(rest.substr(6, rest.size() - 7)));
+      if (rest.back() != ']') fail("DPRNT[ is not closed by ]");
+      return true;
+    }
+    if (rest.rfind("M98", 0) == 0 || rest.rfind("M99", 0) == 0 || rest.rfind("G65", 0) == 0)
+      fail("subprogram calls (M98/M99/G65) are not modelled by the simulator");
+    return false;
+  }
+
+  std::size_t label(int n) {
+    const auto it = labels_.find(n);
+    if (it == labels_.end()) fail("GOTO " + std::to_string(n) + ": no block N" + std::to_string(n));
+    return it->second;
+  }
+
+  // Fanuc DPRNT: letters as they are, '*' = space, #i[ab] = value with a integer and b
+  // decimal digits (sign column first).
+  std::string dprnt(const std::string& body) {
+    std::string out;
+    Cursor c{body, 0};
+    while (!c.end()) {
+      if (c.take("*")) {
+        out += ' ';
+      } else if (c.take("#")) {
+        const double v = in_.parameter(paramNumber(c));
+        if (!c.take("[")) fail("DPRNT #i needs a format [ab]");
+        const std::size_t close = body.find(']', c.i);
+        if (close == std::string::npos || close - c.i != 2) fail("DPRNT format must be [ab], two digits");
+        const int a = body[c.i] - '0', b = body[c.i + 1] - '0';
+        c.i = close + 1;
+        char buf[64];
+        if (b == 0) std::snprintf(buf, sizeof buf, "%*ld", a + 1, std::lround(v));
+        else std::snprintf(buf, sizeof buf, "%*.*f", a + 2 + b, b, v);
+        out += buf;
+      } else {
+        out += c.peek();
+        ++c.i;
+      }
+    }
+    return out;
+  }
+
+  // LinuxCNC active comments.
+  void activeComment(const std::string& body) {
+    const std::string u = upper(body);
+    const auto comma = body.find(',');
+    const std::string text = comma == std::string::npos ? "" : body.substr(comma + 1);
+    if (u.rfind("LOGOPEN", 0) == 0 || u.rfind("LOGAPPEND", 0) == 0) {
+      m_.openLog(text);
+      log_open_ = true;
+    } else if (u.rfind("LOGCLOSE", 0) == 0) {
+      m_.closeLog();
+      log_open_ = false;
+    } else if (u.rfind("LOG", 0) == 0) {
+      if (log_open_) m_.log(substitute(text));
+    } else if (u.rfind("ABORT", 0) == 0) {
+      stop(in_.file_, line_, "program aborted: " + substitute(text));
+    }
+    // MSG, DEBUG, PRINT: operator messages, no effect on the machine.
+  }
+
+  // LinuxCNC substitutes #n and #<name> in LOG text with "%lf" and nothing else.
+  std::string substitute(const std::string& text) {
+    std::string out;
+    for (std::size_t i = 0; i < text.size();) {
+      if (text[i] == '#' && i + 1 < text.size()) {
+        if (text[i + 1] == '<') {
+          const auto close = text.find('>', i);
+          if (close != std::string::npos) {
+            std::string name;
+            for (std::size_t k = i + 2; k < close; ++k)
+              if (!std::isspace(static_cast<unsigned char>(text[k])))
+                name += static_cast<char>(std::tolower(static_cast<unsigned char>(text[k])));
+            const auto it = in_.named_.find(name);
+            if (it == in_.named_.end()) fail("LOG names #<" + name + ">, which is not set");
+            out += fmtLf(it->second);
+            i = close + 1;
+            continue;
+          }
+        } else if (std::isdigit(static_cast<unsigned char>(text[i + 1]))) {
+          std::size_t k = i + 1;
+          while (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k]))) ++k;
+          out += fmtLf(in_.parameter(std::stoi(text.substr(i + 1, k - i - 1))));
+          i = k;
+          continue;
+        }
+      }
+      out += text[i++];
+    }
+    return out;
+  }
+  static std::string fmtLf(double v) {
+    char b[64];
+    std::snprintf(b, sizeof b, "%f", v);
+    return b;
+  }
+
+  // #i=expr, #<name>=expr (LinuxCNC allows several on a line; values are read first).
+  void assign(const std::string& stmt) {
+    Cursor c{stmt, 0};
+    std::vector<std::pair<std::variant<int, std::string>, double>> sets;
+    while (c.take("#")) {
+      std::variant<int, std::string> target;
+      if (c.peek() == '<') {
+        const auto close = stmt.find('>', c.i);
+        if (close == std::string::npos) fail("named parameter '#<' is not closed");
+        target = stmt.substr(c.i + 1, close - c.i - 1);
+        c.i = close + 1;
+      } else {
+        target = paramNumber(c);
+      }
+      if (!c.take("=")) fail("expected '=' after the parameter in '" + stmt + "'");
+      sets.push_back({target, expression(c)});
+    }
+    if (!c.end()) fail("unexpected '" + stmt.substr(c.i) + "' after a parameter assignment");
+    for (const auto& [t, v] : sets) {
+      if (std::holds_alternative<std::string>(t)) {
+        in_.named_[std::get<std::string>(t)] = v;
+        continue;
+      }
+      const int n = std::get<int>(t);
+      if (n == 3000 && in_.dialect_ == ProgramDialect::FanucMacroB)
+        stop(in_.file_, line_, "program alarm #3000=" + std::to_string(std::lround(v)) +
+                                   alarmText(in_.lines_[pc_].comment));
+      if (n >= 5000 && n < 6000) fail("parameter #" + std::to_string(n) + " is read-only");
+      in_.params_[n] = v;
+    }
+  }
+  static std::string alarmText(const std::string& comment) {
+    return comment.empty() ? "" : " (" + comment + ")";
+  }
+
+  // ---------------------------------------------------------------------------------
+  // Ordinary blocks
+
+  struct Words {
+    std::vector<double> g, m;
+    std::map<char, double> v;
+    bool has(char k) const { return v.count(k) > 0; }
+  };
+
+  bool block(const std::string& code) {
+    if (code[0] == '#') {
+      assign(code);
+      return false;
+    }
+    if (code[0] == '/') fail("block delete '/' is not modelled by the simulator");
+    Words w;
+    Cursor c{code, 0};
+    while (!c.end()) {
+      const char letter = c.peek();
+      if (!std::isalpha(static_cast<unsigned char>(letter)))
+        fail("expected a word letter at column " + std::to_string(c.i + 1) + " of '" + code + "'");
+      ++c.i;
+      if (c.peek() == '=') fail("unexpected '=' in '" + code + "'");
+      const double v = wordValue(c);
+      if (letter == 'G') w.g.push_back(std::round(v * 10) / 10);
+      else if (letter == 'M') w.m.push_back(v);
+      else if (letter == 'N') continue;
+      else {
+        static const std::string allowed = "XYZBCFSTHPLIJRK";
+        if (allowed.find(letter) == std::string::npos)
+          fail("word '" + std::string(1, letter) + "' is not modelled by the simulator");
+        if (w.v.count(letter)) fail("word '" + std::string(1, letter) + "' appears twice");
+        w.v[letter] = v;
+      }
+    }
+    return execute(w);
+  }
+
+  static bool isG(double g, double want) { return std::fabs(g - want) < 1e-6; }
+
+  bool execute(Words& w) {
+    bool g53 = false, g31 = false, g10 = false, g4 = false;
+    std::optional<double> motion;
+    for (double g : w.g) {
+      if (isG(g, 0) || isG(g, 1) || isG(g, 2) || isG(g, 3) || isG(g, 80)) motion = g;
+      else if ((isG(g, 38.2) || isG(g, 38.3)) && in_.dialect_ == ProgramDialect::LinuxCnc) motion = g;
+      else if (isG(g, 31) && in_.dialect_ == ProgramDialect::FanucMacroB) g31 = true;
+      else if (isG(g, 90)) absolute_ = true;
+      else if (isG(g, 91)) absolute_ = false;
+      else if (isG(g, 21) || isG(g, 17) || isG(g, 40) || isG(g, 94)) {
+      } else if (isG(g, 20)) fail("G20 (inch) is not modelled by the simulator; the planner writes G21");
+      else if (isG(g, 18) || isG(g, 19)) fail("planes other than G17 are not modelled by the simulator");
+      else if (isG(g, 49)) tool_length_ = 0;
+      else if (isG(g, 43)) {
+        const int h = w.has('H') ? static_cast<int>(std::lround(w.v['H'])) : tool_in_spindle_;
+        tool_length_ = m_.toolLength(h);
+      } else if (isG(g, 53)) g53 = true;
+      else if (g >= 54 - 1e-6 && g <= 59 + 1e-6 && isG(g, std::round(g))) wcs_ = static_cast<int>(std::lround(g)) - 53;
+      else if (isG(g, 10)) g10 = true;
+      else if (isG(g, 4)) g4 = true;
+      else fail("G" + fmtG(g) + " is not modelled by the simulator");
+    }
+    if (w.has('F')) feed_ = w.v['F'];
+    if (w.has('T')) tool_selected_ = static_cast<int>(std::lround(w.v['T']));
+    if (w.has('S')) {
+      spindle_rpm_ = w.v['S'];
+    }
+    for (double m : w.m) {
+      const int mi = static_cast<int>(std::lround(m));
+      if (mi == 6) {
+        m_.toolChange(tool_selected_);
+        tool_in_spindle_ = tool_selected_;
+      } else if (mi == 3 || mi == 4) m_.spindle(mi == 3 ? spindle_rpm_ : -spindle_rpm_);
+      else if (mi == 5) m_.spindle(0);
+      else if (mi == 8) m_.coolant(true);
+      else if (mi == 9) m_.coolant(false);
+      else if (mi == 2 || mi == 30) return true;
+      else if (mi == 19) {
+      }  // spindle orientation: the probe's angular position is fixed anyway
+      else fail("M" + std::to_string(mi) + " is not modelled by the simulator");
+    }
+    if (g10) {
+      if (!w.has('L') || std::lround(w.v['L']) != 2 || !w.has('P'))
+        fail("only G10 L2 Pn (set a work offset) is modelled");
+      int p = static_cast<int>(std::lround(w.v['P']));
+      if (p == 0) p = wcs_;
+      if (p < 1 || p > 6) fail("G10 L2 P" + std::to_string(p) + ": P must be 1..6");
+      const char ax[] = {'X', 'Y', 'Z', 'B', 'C'};
+      for (int a = 0; a < 5; ++a)
+        if (w.has(ax[a])) offsets_[p][a] = w.v[ax[a]];
+      return false;
+    }
+    if (g4) {
+      const char key = in_.dialect_ == ProgramDialect::LinuxCnc ? 'P' : 'X';
+      if (!w.has(key)) fail(std::string("G4 needs ") + key + " (seconds)");
+      if (w.v[key] < 0) fail("G4 with a negative time");
+      m_.dwell(w.v[key]);
+      return false;
+    }
+    if (motion) motion_ = *motion;
+    const bool axes = w.has('X') || w.has('Y') || w.has('Z') || w.has('B') || w.has('C');
+    if (!axes) {
+      if (g31 || g53) fail("G31/G53 without an axis word");
+      return false;
+    }
+    MachinePosition to = target(w, g53);
+    if (g31) {
+      requireFeed();
+      const auto r = m_.probe(to, feed_, ProbeMode::SkipToTarget);
+      setProbeResult(r);
+      return false;
+    }
+    if (isG(motion_, 0)) m_.rapid(to);
+    else if (isG(motion_, 1)) {
+      requireFeed();
+      m_.feed(to, feed_);
+    } else if (isG(motion_, 2) || isG(motion_, 3)) {
+      requireFeed();
+      arc(w, to, isG(motion_, 2));
+    } else if (isG(motion_, 38.2) || isG(motion_, 38.3)) {
+      requireFeed();
+      const auto r = m_.probe(to, feed_, isG(motion_, 38.2) ? ProbeMode::ErrorWithoutContact
+                                                            : ProbeMode::FlagContact);
+      if (isG(motion_, 38.2) && !r.contact)
+        stop(in_.file_, line_, "G38.2 probe move finished without contact");
+      in_.params_[5070] = r.contact ? 1 : 0;
+      setProbeResult(r);
+      return false;
+    } else {
+      fail("axis words with G80 active (no motion mode)");
+    }
+    pos_ = to;
+    return false;
+  }
+
+  void requireFeed() {
+    if (!(feed_ > 0)) fail("a feed move without a feed rate F");
+  }
+
+  static std::string fmtG(double g) {
+    char b[16];
+    std::snprintf(b, sizeof b, "%g", g);
+    return b;
+  }
+
+  std::array<double, 5> activeOffset() const {
+    auto o = offsets_[static_cast<std::size_t>(wcs_)];
+    o[2] += tool_length_;
+    return o;
+  }
+
+  MachinePosition target(Words& w, bool machine_coords) {
+    MachinePosition t = pos_;
+    const auto off = machine_coords ? std::array<double, 5>{} : activeOffset();
+    if (machine_coords && !absolute_) fail("G53 with G91 is not allowed");
+    double* dst[] = {&t.xyz_mm.x(), &t.xyz_mm.y(), &t.xyz_mm.z(), &t.b_deg, &t.c_deg};
+    const double cur[] = {pos_.xyz_mm.x(), pos_.xyz_mm.y(), pos_.xyz_mm.z(), pos_.b_deg, pos_.c_deg};
+    const char ax[] = {'X', 'Y', 'Z', 'B', 'C'};
+    for (int a = 0; a < 5; ++a) {
+      if (!w.has(ax[a])) continue;
+      *dst[a] = absolute_ ? w.v[ax[a]] + off[static_cast<std::size_t>(a)] : cur[a] + w.v[ax[a]];
+    }
+    return t;
+  }
+
+  // After a probe move both dialects report the latched position in program coordinates.
+  void setProbeResult(const ProbeOutcome& r) {
+    const auto off = activeOffset();
+    in_.params_[5061] = r.stop.xyz_mm.x() - off[0];
+    in_.params_[5062] = r.stop.xyz_mm.y() - off[1];
+    in_.params_[5063] = r.stop.xyz_mm.z() - off[2];
+    in_.params_[5064] = r.stop.b_deg - off[3];
+    in_.params_[5065] = r.stop.c_deg - off[4];
+    pos_ = r.stop;
+  }
+
+  // G2/G3 in the XY plane as chords within 0.1 um of the arc.
+  void arc(Words& w, const MachinePosition& to, bool clockwise) {
+    const Eigen::Vector2d a = pos_.xyz_mm.head<2>(), b = to.xyz_mm.head<2>();
+    Eigen::Vector2d centre;
+    if (w.has('R')) {
+      const double r = w.v['R'], d = (b - a).norm();
+      if (d < 1e-9 || std::fabs(r) < d / 2 - 1e-9) fail("arc radius R is too small for the end point");
+      const double h = std::sqrt(std::max(0.0, r * r - d * d / 4));
+      const Eigen::Vector2d mid = (a + b) / 2, perp = Eigen::Vector2d(-(b - a).y(), (b - a).x()) / d;
+      // R > 0: the short arc; the centre lies to the right of a->b for G2.
+      const double side = (clockwise ? -1.0 : 1.0) * (r > 0 ? 1.0 : -1.0);
+      centre = mid + side * h * perp;
+    } else {
+      if (!w.has('I') && !w.has('J')) fail("G2/G3 needs I/J (centre) or R");
+      centre = a + Eigen::Vector2d(w.has('I') ? w.v['I'] : 0.0, w.has('J') ? w.v['J'] : 0.0);
+    }
+    const double ra = (a - centre).norm(), rb = (b - centre).norm();
+    if (ra < 1e-9) fail("arc with zero radius");
+    if (std::fabs(ra - rb) > 0.002) fail("arc end point is not on the arc (radius differs by " + std::to_string(std::fabs(ra - rb)) + " mm)");
+    double t0 = std::atan2(a.y() - centre.y(), a.x() - centre.x());
+    double t1 = std::atan2(b.y() - centre.y(), b.x() - centre.x());
+    double sweep = t1 - t0;
+    if (clockwise) {
+      if (sweep >= -1e-12) sweep -= 2 * kPi;
+    } else if (sweep <= 1e-12) sweep += 2 * kPi;
+    const double tol = 1e-4;
+    const double max_step = 2 * std::acos(std::max(-1.0, 1 - tol / ra));
+    const int n = std::max(1, static_cast<int>(std::ceil(std::fabs(sweep) / max_step)));
+    for (int k = 1; k <= n; ++k) {
+      const double s = static_cast<double>(k) / n;
+      MachinePosition p = to;
+      if (k < n) {
+        const double t = t0 + sweep * s;
+        p.xyz_mm.x() = centre.x() + ra * std::cos(t);
+        p.xyz_mm.y() = centre.y() + ra * std::sin(t);
+        p.xyz_mm.z() = pos_.xyz_mm.z() + (to.xyz_mm.z() - pos_.xyz_mm.z()) * s;
+      }
+      m_.feed(p, feed_);
+    }
+  }
+};
+
+InterpreterResult Interpreter::run(MachineInterface& machine, long max_blocks) {
+  Execution e(*this, machine);
+  return e.run(max_blocks);
+}
+
+}  // namespace probeloop::gcode

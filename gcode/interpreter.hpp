@@ -1,0 +1,96 @@
+// Interpreter of the G-code the planner emits, in both dialects (LinuxCNC RS274NGC and
+// Fanuc macro B): modal state, G0/G1/G2/G3 (XY plane), G38.2/G38.3 and G31 probing, G4,
+// T/M6, G43/G49, M3/M4/M5 with S, M8/M9, G10 L2, G53, G54-G59, rotary axes B and C,
+// #-parameters (numbered, and LinuxCNC named #<...>), expressions with [ ], functions and
+// comparisons, LinuxCNC o-word while/if/elseif/else and Fanuc WHILE/DO/END, IF..GOTO,
+// IF..THEN, GOTO, #3000 alarms, LinuxCNC LOGOPEN/LOG/LOGCLOSE/ABORT and Fanuc
+// POPEN/DPRNT/PCLOS.
+//
+// Contract: the interpreter owns the controller's view (program coordinates, offsets,
+// parameters, control flow) and asks a MachineInterface to move; the machine answers with
+// what physically happened (probe contact) and keeps time. Positions handed to the machine
+// are machine coordinates of the controlled point of the spindle (the gauge line): program
+// coordinates + work offset + tool length (G43). Anything the interpreter does not model
+// (a word, a G or M code, an o-word keyword, M98 subprograms, inch units, another plane)
+// is an InputError "<file>:<line>: ..." naming it, never a silent skip. Errors the machine
+// raises (SafetyError, InputError without a line) are re-thrown with the program line.
+#pragma once
+#include <Eigen/Dense>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace probeloop::gcode {
+
+enum class ProgramDialect { LinuxCnc, FanucMacroB };
+
+struct MachinePosition {
+  Eigen::Vector3d xyz_mm = Eigen::Vector3d::Zero();  // gauge line, machine coordinates
+  double b_deg = 0, c_deg = 0;
+};
+
+enum class ProbeMode {
+  ErrorWithoutContact,  // LinuxCNC G38.2: no contact is an error that stops the program
+  FlagContact,          // LinuxCNC G38.3: stops on contact, #5070 says whether it did
+  SkipToTarget,         // Fanuc G31: stops on contact, completes the move otherwise
+};
+
+struct ProbeOutcome {
+  bool contact = false;
+  MachinePosition stop;  // where the controller latched (contact) or the target (none)
+};
+
+// The physical machine the program runs on. Each call advances the machine's clock.
+class MachineInterface {
+ public:
+  virtual ~MachineInterface() = default;
+  virtual void rapid(const MachinePosition& to) = 0;
+  virtual void feed(const MachinePosition& to, double feed_mm_per_min) = 0;
+  virtual ProbeOutcome probe(const MachinePosition& to, double feed_mm_per_min, ProbeMode mode) = 0;
+  virtual void dwell(double seconds) = 0;
+  virtual void toolChange(int tool) = 0;
+  virtual double toolLength(int tool) const = 0;  // InputError for an unknown tool
+  virtual void spindle(double rpm) = 0;           // 0 = stopped; negative = M4
+  virtual void coolant(bool on) = 0;
+  virtual void openLog(const std::string& name) = 0;
+  virtual void log(const std::string& line) = 0;  // one line as the controller writes it
+  virtual void closeLog() = 0;
+  // Where the machine stands when the program starts (gauge line, machine coordinates).
+  virtual MachinePosition start() const { return {}; }
+};
+
+struct InterpreterResult {
+  long blocks_executed = 0;
+  bool ended = false;  // M2/M30 reached
+};
+
+class Interpreter {
+ public:
+  Interpreter(ProgramDialect dialect, std::string file_name, const std::string& text);
+
+  // Runs from the first line to M2/M30 (or the end of the text). `max_blocks` bounds a
+  // program that never ends (an InputError names the line it was at).
+  InterpreterResult run(MachineInterface& machine, long max_blocks = 100'000'000);
+
+  // Parameters after (or during) a run, for tests: numbered and named (lower case).
+  double parameter(int number) const;
+  double namedParameter(const std::string& name) const;
+
+  struct Line {
+    int number = 0;       // 1-based line in the file
+    std::string code;     // upper case, comments and blanks removed (LinuxCNC named
+                          // parameters keep their lower-case names)
+    std::string message;  // the (LOG,...)-style comment's text, original case
+    std::string comment;  // the last comment on the line (Fanuc alarm texts)
+  };
+
+ private:
+  ProgramDialect dialect_;
+  std::string file_;
+  std::vector<Line> lines_;
+  std::map<int, double> params_;
+  std::map<std::string, double> named_;
+  friend class Execution;
+};
+
+}  // namespace probeloop::gcode

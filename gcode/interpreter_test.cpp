@@ -1,0 +1,215 @@
+#include "gcode/interpreter.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "core/error.hpp"
+#include "gcode/probe_program.hpp"
+
+namespace probeloop::gcode {
+namespace {
+
+// Records every call; probes touch a plane x = contact_x (moving in +X) when set.
+struct Recorder : MachineInterface {
+  std::vector<std::string> calls;
+  std::vector<MachinePosition> targets;
+  std::vector<std::string> log_lines;
+  std::optional<double> contact_x;
+  double path_mm = 0;
+  MachinePosition at;
+  void rapid(const MachinePosition& to) override { calls.push_back("G0"); targets.push_back(to); at = to; }
+  void feed(const MachinePosition& to, double) override {
+    calls.push_back("G1");
+    path_mm += (to.xyz_mm - at.xyz_mm).norm();
+    targets.push_back(to);
+    at = to;
+  }
+  ProbeOutcome probe(const MachinePosition& to, double, ProbeMode mode) override {
+    calls.push_back(mode == ProbeMode::ErrorWithoutContact ? "G38.2" : mode == ProbeMode::FlagContact ? "G38.3" : "G31");
+    targets.push_back(to);
+    ProbeOutcome o;
+    if (contact_x && to.xyz_mm.x() >= *contact_x && at.xyz_mm.x() < *contact_x) {
+      o.contact = true;
+      o.stop = to;
+      o.stop.xyz_mm.x() = *contact_x;
+    } else {
+      o.stop = to;
+    }
+    at = o.stop;
+    return o;
+  }
+  void dwell(double s) override { calls.push_back("G4 " + std::to_string(s)); }
+  void toolChange(int t) override { calls.push_back("M6 T" + std::to_string(t)); }
+  double toolLength(int t) const override {
+    if (t == 99) return 150;
+    if (t == 0) return 0;
+    throw InputError("", 0, "no tool " + std::to_string(t));
+  }
+  void spindle(double rpm) override { calls.push_back("S " + std::to_string(rpm)); }
+  void coolant(bool on) override { calls.push_back(on ? "M8" : "M9"); }
+  void openLog(const std::string& n) override { calls.push_back("open " + n); }
+  void log(const std::string& l) override { log_lines.push_back(l); }
+  void closeLog() override { calls.push_back("close"); }
+};
+
+TEST(Interpreter, ExpressionsFollowRs274Precedence) {
+  Recorder r;
+  Interpreter in(ProgramDialect::LinuxCnc, "t.ngc",
+                 "#1 = [1 + 2 * 3]\n#2 = [2 ** 3 ** 2]\n#3 = [7 MOD 3]\n#4 = [1 LT 2 AND 3 GT 4]\n"
+                 "#5 = ATAN[1]/[1]\n#6 = [SQRT[16] + ABS[-2] + FIX[2.7] + FUP[2.1] + ROUND[2.5]]\n"
+                 "#<_a> = [-#1 + COS[60]]\n#7 = #[2 + 1]\nM2\n");
+  in.run(r);
+  EXPECT_EQ(in.parameter(1), 7);
+  EXPECT_EQ(in.parameter(2), 64);  // left to right: (2**3)**2
+  EXPECT_EQ(in.parameter(3), 1);
+  EXPECT_EQ(in.parameter(4), 0);
+  EXPECT_NEAR(in.parameter(5), 45, 1e-12);
+  EXPECT_EQ(in.parameter(6), 4 + 2 + 2 + 3 + 3);
+  EXPECT_NEAR(in.namedParameter("_a"), -6.5, 1e-12);
+  EXPECT_EQ(in.parameter(7), 1);
+}
+
+TEST(Interpreter, LinuxCncLoopsAndBranches) {
+  Recorder r;
+  Interpreter in(ProgramDialect::LinuxCnc, "t.ngc",
+                 "#<n> = 0\n#<sum> = 0\no1 while [#<n> LT 5]\n"
+                 "  o2 if [#<n> EQ 1]\n    #<sum> = [#<sum> + 10]\n"
+                 "  o2 elseif [#<n> EQ 2]\n    #<sum> = [#<sum> + 100]\n"
+                 "  o2 else\n    #<sum> = [#<sum> + 1]\n  o2 endif\n"
+                 "  #<n> = [#<n> + 1]\no1 endwhile\nM2\n");
+  const auto res = in.run(r);
+  EXPECT_TRUE(res.ended);
+  EXPECT_EQ(in.namedParameter("sum"), 10 + 100 + 3);
+}
+
+TEST(Interpreter, RunsTheEmittedLinuxCncProbeBlocksAndLogsLikeLinuxCnc) {
+  ProbeProgram p;
+  p.title = "t";
+  p.log_file = "probe.log";
+  p.cycles = 2;
+  p.gap_s = 300;
+  p.cycle_body = {ToolChange{99, true}, Rapid{10.0, 0.0, 20.0},
+                  ProtectedMove{0, 0, 20, 1000}, ProbeMove{30, 0, 20, 200, 1, 1}, ToolChange{0, false}};
+  Recorder r;
+  r.contact_x = 12.5;  // the protected move (x 10 -> 0) moves away from it: no contact
+  Interpreter in(ProgramDialect::LinuxCnc, "t.ngc", writeLinuxCnc(p));
+  in.run(r);
+  ASSERT_EQ(r.log_lines.size(), 2u);
+  // LinuxCNC substitutes parameters with %lf (checked against rs274's own LOG output).
+  EXPECT_EQ(r.log_lines[0], "PT 1.000000 1 1 12.500000 0.000000 20.000000");
+  EXPECT_EQ(r.log_lines[1], "PT 2.000000 1 1 12.500000 0.000000 20.000000");
+  // Targets are gauge-line machine coordinates: the probe's 150 mm length is added.
+  EXPECT_DOUBLE_EQ(r.targets[0].xyz_mm.z(), 170.0);
+  int dwells = 0;
+  for (const auto& c : r.calls) dwells += c.rfind("G4", 0) == 0;
+  EXPECT_EQ(dwells, 1);  // only between the cycles
+}
+
+TEST(Interpreter, FanucProgramWithSkipAlarmsAndDprnt) {
+  ProbeProgram p;
+  p.title = "t";
+  p.cycles = 3;
+  p.gap_s = 60;
+  p.cycle_body = {ToolChange{99, true}, Rapid{10.0, 0.0, 20.0}, ProbeMove{30, 0, 20, 200, 2, 4}};
+  Recorder r;
+  r.contact_x = 12.5;
+  Interpreter in(ProgramDialect::FanucMacroB, "t.nc", writeFanucMacroB(p));
+  in.run(r);
+  ASSERT_EQ(r.log_lines.size(), 5u);  // % + 3 points + %
+  EXPECT_EQ(r.log_lines.front(), "%");
+  // '*' prints a space, #i[ab] a sign column, a integer and b decimal digits.
+  EXPECT_EQ(r.log_lines[1], "PT     1 2 4    12.5000     0.0000    20.0000");
+  EXPECT_EQ(r.log_lines[3], "PT     3 2 4    12.5000     0.0000    20.0000");
+
+  // Without contact the program's own check raises alarm #3000=1 at its line.
+  Recorder none;
+  Interpreter in2(ProgramDialect::FanucMacroB, "t.nc", writeFanucMacroB(p));
+  try {
+    in2.run(none);
+    FAIL() << "expected the alarm";
+  } catch (const SafetyError& e) {
+    const std::string w = e.what();
+    EXPECT_NE(w.find("t.nc:"), std::string::npos) << w;
+    EXPECT_NE(w.find("#3000=1"), std::string::npos) << w;
+    EXPECT_NE(w.find("PROBE DID NOT TRIGGER"), std::string::npos) << w;
+  }
+}
+
+TEST(Interpreter, G382WithoutContactStopsTheProgram) {
+  Recorder r;
+  Interpreter in(ProgramDialect::LinuxCnc, "t.ngc", "G21 G90\nG0 X0 Y0 Z0\nG38.2 X5 F100\nM2\n");
+  try {
+    in.run(r);
+    FAIL();
+  } catch (const SafetyError& e) {
+    EXPECT_NE(std::string(e.what()).find("t.ngc:3: G38.2 probe move finished without contact"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(Interpreter, ArcsAreFollowedWithinATenthOfAMicrometre) {
+  Recorder r;
+  Interpreter in(ProgramDialect::LinuxCnc, "t.ngc", "G0 X10 Y0 Z0\nG3 X0 Y10 I-10 J0 F500\nG2 X10 Y0 R10\nM2\n");
+  in.run(r);
+  // Quarter circle of radius 10 twice: chords are shorter than the arc by < 1e-4 relative.
+  EXPECT_NEAR(r.path_mm, 2 * 10 * std::numbers::pi / 2, 2e-3);
+  EXPECT_LT(r.path_mm, 2 * 10 * std::numbers::pi / 2);
+  for (std::size_t k = 1; k < r.targets.size(); ++k)
+    EXPECT_NEAR(r.targets[k].xyz_mm.head<2>().norm(), 10.0, 1e-9);
+  EXPECT_NEAR(r.targets.back().xyz_mm.x(), 10.0, 1e-12);
+}
+
+TEST(Interpreter, WorkOffsetsToolLengthAndMachineCoordinates) {
+  Recorder r;
+  Interpreter in(ProgramDialect::LinuxCnc, "t.ngc",
+                 "G10 L2 P2 X100 Y-50 Z5 C0\nG55\nT99 M6\nG43 H99\nG0 X1 Y2 Z3\nG91 G0 X1\nG90\nG53 G0 Z400\nM2\n");
+  in.run(r);
+  ASSERT_EQ(r.targets.size(), 3u);
+  EXPECT_EQ(r.targets[0].xyz_mm, Eigen::Vector3d(101, -48, 158));
+  EXPECT_EQ(r.targets[1].xyz_mm, Eigen::Vector3d(102, -48, 158));
+  EXPECT_EQ(r.targets[2].xyz_mm, Eigen::Vector3d(102, -48, 400));
+}
+
+// Bad input: every refusal names the file and line and what is not modelled.
+void expectInputError(ProgramDialect d, const std::string& text, const std::string& want) {
+  Recorder r;
+  try {
+    Interpreter in(d, "bad.ngc", text);
+    in.run(r);
+    FAIL() << "accepted: " << text;
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
+  }
+}
+
+TEST(Interpreter, RefusesWhatItDoesNotModelWithTheLine) {
+  expectInputError(ProgramDialect::LinuxCnc, "G0 X0\nG0 Q5\n", "bad.ngc:2: word 'Q' is not modelled");
+  expectInputError(ProgramDialect::LinuxCnc, "G0 X0\nG81 X1 Z-1 R1\n", "bad.ngc:2: G81 is not modelled");
+  expectInputError(ProgramDialect::LinuxCnc, "G20\n", "bad.ngc:1: G20 (inch)");
+  expectInputError(ProgramDialect::LinuxCnc, "M7\n", "bad.ngc:1: M7 is not modelled");
+  expectInputError(ProgramDialect::LinuxCnc, "o10 sub\no10 endsub\n", "bad.ngc:1: o-word 'sub' is not modelled");
+  expectInputError(ProgramDialect::LinuxCnc, "o1 while [1]\nG0 X0\n", "bad.ngc:1: this block is never closed");
+  expectInputError(ProgramDialect::LinuxCnc, "#1 = [1 +* 2]\n", "bad.ngc:1:");
+  expectInputError(ProgramDialect::LinuxCnc, "G1 X5\n", "bad.ngc:1: a feed move without a feed rate");
+  expectInputError(ProgramDialect::LinuxCnc, "#1 = [#<nope> + 1]\n", "#<nope> is read before it is set");
+  expectInputError(ProgramDialect::LinuxCnc, "T5 M6\nG43\n", "bad.ngc:2: no tool 5");
+  expectInputError(ProgramDialect::FanucMacroB, "M98 P1000\n", "bad.ngc:1: subprogram calls");
+  expectInputError(ProgramDialect::FanucMacroB, "G38.2 X1 F100\n", "bad.ngc:1: G38.2 is not modelled");
+  expectInputError(ProgramDialect::FanucMacroB, "GOTO 5\n", "bad.ngc:1: GOTO 5: no block N5");
+}
+
+TEST(Interpreter, AnEndlessLoopIsStoppedAndNamed) {
+  Recorder r;
+  Interpreter in(ProgramDialect::LinuxCnc, "loop.ngc", "o1 while [1]\no1 endwhile\n");
+  try {
+    in.run(r, 1000);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("endless loop"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace probeloop::gcode

@@ -1,0 +1,294 @@
+#include "sim/machine_truth.hpp"
+
+#include <cmath>
+
+#include "core/error.hpp"
+#include "core/units.hpp"
+#include "parts/yaml_reader.hpp"
+
+namespace probeloop::sim {
+
+using parts::YamlMap;
+
+bool ErrorVector::any() const {
+  for (double v : location)
+    if (v != 0) return true;
+  for (double v : tool_um)
+    if (v != 0) return true;
+  return false;
+}
+
+int ThermalTruth::nodeIndex(const std::string& name) const {
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    if (nodes[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+double EnvironmentProfile::at(double t) const {
+  constexpr double day = 86400.0;
+  double T = mean_C + drift_K_per_s * t +
+             daily_amplitude_K * std::cos(2 * kPi * (start_clock_s + t - peak_clock_s) / day);
+  for (const auto& e : events) {
+    const double u = t - e.at_s;
+    if (u <= 0) continue;
+    double f;  // fraction of the change in force
+    if (u < e.ramp_s) f = u / e.ramp_s;
+    else if (u < e.ramp_s + e.hold_s) f = 1;
+    else if (e.recover_s > 0 && u < e.ramp_s + e.hold_s + e.recover_s) f = 1 - (u - e.ramp_s - e.hold_s) / e.recover_s;
+    else f = e.recover_s > 0 || e.hold_s > 0 ? 0 : 1;  // no hold/recover given: a lasting step
+    T += f * e.change_K;
+  }
+  return T;
+}
+
+geometry::LocationErrors MachineTruth::keyframeAt(double t) const {
+  if (keyframes.empty()) return {};
+  if (t <= keyframes.front().time_s) return keyframes.front().errors;
+  if (t >= keyframes.back().time_s) return keyframes.back().errors;
+  for (std::size_t i = 1; i < keyframes.size(); ++i) {
+    if (t <= keyframes[i].time_s) {
+      const auto va = keyframes[i - 1].errors.values(), vb = keyframes[i].errors.values();
+      const double w = (t - keyframes[i - 1].time_s) / (keyframes[i].time_s - keyframes[i - 1].time_s);
+      std::array<double, 7> v;
+      for (int j = 0; j < 7; ++j) v[j] = va[j] + w * (vb[j] - va[j]);
+      return geometry::LocationErrors::fromValues(v);
+    }
+  }
+  return keyframes.back().errors;
+}
+
+namespace {
+
+// Keys of an error vector with a suffix: "EX0C_um" + suffix ("" or "_per_K").
+ErrorVector readErrorVector(YamlMap& m, const std::string& suffix) {
+  ErrorVector e;
+  for (int j = 0; j < 7; ++j)
+    e.location[j] = m.numberOr(std::string(geometry::LocationErrors::names()[j]) + suffix, 0.0);
+  const char* tool[] = {"tool_X_um", "tool_Y_um", "tool_Z_um"};
+  for (int a = 0; a < 3; ++a) e.tool_um[a] = m.numberOr(std::string(tool[a]) + suffix, 0.0);
+  return e;
+}
+
+std::vector<double> numberList(YamlMap& m, const std::string& key) {
+  return m.quantityList(key, Dimension::Micrometre);  // bare numbers: coefficients as written
+}
+
+void loadThermal(YamlMap t, ThermalTruth& th) {
+  th.present = true;
+  th.max_step_s = t.quantityOr("max_step", Dimension::Duration, 60);
+  if (!(th.max_step_s > 0)) t.fail("max_step", "must be positive");
+  if (auto e = t.mapIfPresent("environment")) {
+    auto& env = th.environment;
+    env.mean_C = e->numberOr("mean_C", 20);
+    env.daily_amplitude_K = e->numberOr("daily_amplitude_K", 0);
+    env.peak_clock_s = e->quantityOr("peak_clock", Dimension::Duration, 15 * 3600.0);
+    env.start_clock_s = e->quantityOr("start_clock", Dimension::Duration, 0);
+    env.drift_K_per_s = e->numberOr("drift_K_per_day", 0) / 86400.0;
+    if (e->has("events"))
+      for (auto& v : e->mapList("events")) {
+        EnvironmentEvent ev;
+        ev.at_s = v.quantity("at", Dimension::Duration);
+        ev.change_K = v.number("change_K");
+        ev.ramp_s = v.quantityOr("ramp", Dimension::Duration, 0);
+        ev.hold_s = v.quantityOr("hold", Dimension::Duration, 0);
+        ev.recover_s = v.quantityOr("recover", Dimension::Duration, 0);
+        if (ev.ramp_s < 0 || ev.hold_s < 0 || ev.recover_s < 0) v.fail("ramp", "durations must not be negative");
+        v.finish();
+        env.events.push_back(ev);
+      }
+    e->finish();
+  }
+  auto nodes = t.mapList("nodes");
+  for (auto& n : nodes) {
+    ThermalNodeSpec s;
+    s.name = n.string("name");
+    if (s.name == "environment") n.fail("name", "'environment' is reserved for the surroundings");
+    if (th.nodeIndex(s.name) >= 0) n.fail("name", "node '" + s.name + "' is defined twice");
+    s.capacity_J_per_K = n.number("capacity_J_per_K");
+    if (!(s.capacity_J_per_K > 0)) n.fail("capacity_J_per_K", "must be positive");
+    s.to_environment_W_per_K = n.numberOr("to_environment_W_per_K", 0);
+    if (s.to_environment_W_per_K < 0) n.fail("to_environment_W_per_K", "must not be negative");
+    th.nodes.push_back(s);
+    if (auto d = n.mapIfPresent("displacement_per_K")) {
+      th.per_node_K.push_back(readErrorVector(*d, "_per_K"));
+      d->finish();
+    } else {
+      th.per_node_K.push_back({});
+    }
+    n.finish();
+  }
+  auto node = [&](YamlMap& m, const std::string& key, bool env_ok) {
+    const std::string name = m.string(key);
+    if (env_ok && name == "environment") return -1;
+    const int i = th.nodeIndex(name);
+    if (i < 0) m.fail(key, "no thermal node named '" + name + "'");
+    return i;
+  };
+  if (t.has("links"))
+    for (auto& l : t.mapList("links")) {
+      ThermalLinkSpec s;
+      s.a = node(l, "from", false);
+      s.b = node(l, "to", false);
+      if (s.a == s.b) l.fail("to", "a link joins two different nodes");
+      s.conductance_W_per_K = l.number("conductance_W_per_K");
+      if (!(s.conductance_W_per_K > 0)) l.fail("conductance_W_per_K", "must be positive");
+      l.finish();
+      th.links.push_back(s);
+    }
+  if (t.has("sources"))
+    for (auto& s : t.mapList("sources")) {
+      HeatSourceSpec h;
+      h.node = node(s, "node", false);
+      const auto in = s.choice("input", {"c_axis_speed", "spindle_speed", "mwf", "constant"});
+      if (in == "c_axis_speed" || in == "spindle_speed") {
+        h.input = in == "c_axis_speed" ? HeatInput::CAxisRpm : HeatInput::SpindleRpm;
+        h.gain = s.number("W_per_rpm");
+      } else {
+        h.input = in == "mwf" ? HeatInput::Mwf : HeatInput::Constant;
+        h.gain = s.number("W");
+      }
+      s.finish();
+      th.sources.push_back(h);
+    }
+  if (t.has("sensors"))
+    for (auto& s : t.mapList("sensors")) {
+      SensorSpec k;
+      k.column = s.string("column");
+      if (k.column.size() < 3 || (k.column.substr(k.column.size() - 2) != "_C"))
+        s.fail("column", "a temperature column name ends in _C (e.g. T_env_C)");
+      k.node = node(s, "node", true);
+      k.noise_K = s.numberOr("noise_K", 0);
+      if (k.noise_K < 0) s.fail("noise_K", "must not be negative");
+      if (s.has("offset_K")) {
+        if (s.string("offset_K") != "random") k.offset_K = s.number("offset_K");
+      } else {
+        k.offset_K = 0.0;
+      }
+      s.finish();
+      th.sensors.push_back(k);
+    }
+  // Validate the network now, with the file and line of `nodes`.
+  try {
+    ThermalNetwork(th.nodes, th.links, 20.0);
+  } catch (const InputError& e) {
+    t.fail("nodes", e.what());
+  }
+  t.finish();
+}
+
+}  // namespace
+
+MachineTruth loadMachineTruth(const std::string& path) {
+  YamlMap root(parts::loadYamlFile(path), path, "");
+  root.choice("kind", {"machine_truth"});
+  MachineTruth t;
+  t.file = path;
+  if (auto s = root.mapIfPresent("static")) {
+    t.static_errors = readErrorVector(*s, "");
+    s->finish();
+  }
+  if (root.has("location_keyframes")) {
+    double last = -INFINITY;
+    for (auto& k : root.mapList("location_keyframes")) {
+      LocationKeyframeTruth f;
+      f.time_s = k.quantity("time", Dimension::Duration);
+      if (!(f.time_s > last)) k.fail("time", "keyframe times must increase");
+      last = f.time_s;
+      std::array<double, 7> v;
+      for (int j = 0; j < 7; ++j) v[j] = k.numberOr(geometry::LocationErrors::names()[j], 0.0);
+      f.errors = geometry::LocationErrors::fromValues(v);
+      k.finish();
+      t.keyframes.push_back(f);
+    }
+  }
+  if (auto a = root.mapIfPresent("axes")) {
+    const char axn[] = {'X', 'Y', 'Z'};
+    const char* err[] = {"EX", "EY", "EZ", "EA", "EB", "EC"};
+    for (int i = 0; i < 3; ++i) {
+      auto m = a->mapIfPresent(std::string(1, axn[i]));
+      if (!m) continue;
+      for (int e = 0; e < 6; ++e) {
+        const std::string key = std::string(err[e]) + axn[i] + (e < 3 ? "_um" : "_urad");
+        if (m->has(key)) {
+          t.axes.coeff[i][e] = numberList(*m, key);
+          t.axes.any = true;
+        } else {
+          m->numberOr(key, 0);  // allowed key
+        }
+      }
+      m->finish();
+    }
+    a->finish();
+  }
+  if (auto s = root.mapIfPresent("squareness")) {
+    t.EC0Y_urad = s->numberOr("EC0Y_urad", 0);
+    t.EB0Z_urad = s->numberOr("EB0Z_urad", 0);
+    t.EA0Z_urad = s->numberOr("EA0Z_urad", 0);
+    s->finish();
+  }
+  if (auto th = root.mapIfPresent("thermal")) loadThermal(*th, t.thermal);
+  if (auto d = root.mapIfPresent("duty")) {
+    if (auto c = d->mapIfPresent("c_axis")) {
+      if (c->has("levels_rpm")) {
+        t.duty.c_levels_rpm = c->quantityList("levels_rpm", Dimension::RotSpeed);
+        t.duty.hold_s = c->quantity("hold", Dimension::Duration);
+        if (!(t.duty.hold_s > 0)) c->fail("hold", "must be positive");
+      }
+      if (c->has("profile"))
+        for (auto& p : c->mapList("profile")) {
+          t.duty.c_profile.push_back({p.quantity("at", Dimension::Duration), p.quantity("speed", Dimension::RotSpeed)});
+          p.finish();
+        }
+      if (!t.duty.c_levels_rpm.empty() && !t.duty.c_profile.empty())
+        c->fail("profile", "give either levels_rpm + hold (random) or a profile, not both");
+      c->finish();
+    }
+    if (d->has("mwf"))
+      for (auto& p : d->mapList("mwf")) {
+        t.duty.mwf_profile.push_back({p.quantity("at", Dimension::Duration), p.boolean("on")});
+        p.finish();
+      }
+    d->finish();
+  }
+  if (auto p = root.mapIfPresent("probe")) {
+    auto& pr = t.probe;
+    pr.pretravel_um = p->quantityOr("pretravel", Dimension::Micrometre, 0);
+    pr.lobes = p->integerOr("lobes", 3);
+    pr.lobe_amplitude_um = p->quantityOr("lobe_amplitude", Dimension::Micrometre, 0);
+    pr.lobe_phase_deg = p->quantityOr("lobe_phase", Dimension::Angle, 0);
+    pr.pretravel_vertical_um = p->quantityOr("pretravel_vertical", Dimension::Micrometre, 0);
+    pr.trigger_delay_s = p->numberOr("trigger_delay_ms", 0) / 1000.0;
+    pr.noise_um = p->quantityOr("noise", Dimension::Micrometre, 0);
+    pr.quantise = p->booleanOr("quantise", false);
+    if (pr.noise_um < 0) p->fail("noise", "must not be negative");
+    if (pr.trigger_delay_s < 0) p->fail("trigger_delay_ms", "must not be negative");
+    if (pr.lobes < 1) p->fail("lobes", "must be at least 1");
+    p->finish();
+  }
+  if (auto c = root.mapIfPresent("tool_change")) {
+    t.atc_repeatability_um = c->quantity("repeatability", Dimension::Micrometre);
+    if (t.atc_repeatability_um < 0) c->fail("repeatability", "must not be negative");
+    c->finish();
+  }
+  if (auto a = root.mapIfPresent("artifact")) {
+    if (a->has("node")) {
+      const std::string n = a->string("node");
+      t.artifact.node = t.thermal.nodeIndex(n);
+      if (t.artifact.node < 0) a->fail("node", "no thermal node named '" + n + "' (define thermal: before)");
+      t.artifact.alpha_per_K = a->number("alpha_um_per_m_K") * 1e-6;
+    }
+    if (auto p = a->mapIfPresent("placement_error")) {
+      t.artifact.placement_error_mm = Eigen::Vector3d(p->quantityOr("x", Dimension::Micrometre, 0),
+                                                      p->quantityOr("y", Dimension::Micrometre, 0),
+                                                      p->quantityOr("z", Dimension::Micrometre, 0)) * 1e-3;
+      p->finish();
+    }
+    a->finish();
+  }
+  t.inputs_rate_s = root.quantityOr("inputs_rate", Dimension::Duration, 60);
+  if (!(t.inputs_rate_s > 0)) root.fail("inputs_rate", "must be positive");
+  root.finish();
+  return t;
+}
+
+}  // namespace probeloop::sim

@@ -1,0 +1,586 @@
+#include "sim/virtual_machine.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <sstream>
+
+#include "core/csv.hpp"
+#include "core/error.hpp"
+#include "core/units.hpp"
+#include "gcode/probe_log.hpp"
+
+namespace probeloop::sim {
+
+using Eigen::Vector3d;
+using gcode::MachinePosition;
+
+namespace {
+
+// Independent random streams per effect, so switching one effect on does not reshuffle
+// the draws of another (splitmix64 of seed and stream number).
+std::uint64_t streamSeed(std::uint64_t seed, std::uint64_t stream) {
+  std::uint64_t z = seed * 0x9E3779B97F4A7C15ULL + stream * 0xBF58476D1CE4E5B9ULL + 0x94D049BB133111EBULL;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+  return z ^ (z >> 31);
+}
+
+double poly(const std::vector<double>& c, double x) {
+  double v = 0;
+  for (std::size_t k = c.size(); k-- > 0;) v = v * x + c[k];
+  return v;
+}
+
+// Closest distance between segments p0-p1 and q0-q1 (Ericson, Real-Time Collision
+// Detection 5.1.9), with the parameter s on the first segment.
+double segmentDistance(const Vector3d& p0, const Vector3d& p1, const Vector3d& q0, const Vector3d& q1) {
+  const Vector3d d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
+  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
+  double s = 0, t = 0;
+  if (a <= 1e-18 && e <= 1e-18) return r.norm();
+  if (a <= 1e-18) {
+    t = std::clamp(f / e, 0.0, 1.0);
+  } else {
+    const double c = d1.dot(r);
+    if (e <= 1e-18) {
+      s = std::clamp(-c / a, 0.0, 1.0);
+    } else {
+      const double b = d1.dot(d2), den = a * e - b * b;
+      s = den > 1e-18 ? std::clamp((b * f - c * e) / den, 0.0, 1.0) : 0.0;
+      t = (b * s + f) / e;
+      if (t < 0) t = 0, s = std::clamp(-c / a, 0.0, 1.0);
+      else if (t > 1) t = 1, s = std::clamp((b - c) / a, 0.0, 1.0);
+    }
+  }
+  return ((p0 + s * d1) - (q0 + t * d2)).norm();
+}
+
+struct ProbeEvent {
+  double time_s = 0;
+  long log_line = 0;  // 1-based line of the log written after this probe (0 = none)
+  double c_deg = 0;
+  Vector3d approach = Vector3d::Zero();
+  std::array<double, 7> location{};  // table-side location errors at the event
+  Vector3d tool_um = Vector3d::Zero();  // tool-side translation (thermal + static + ATC)
+  Vector3d atc_um = Vector3d::Zero();
+  double artifact_dT_K = 0;
+  std::array<double, 7> apparent{};  // what a sphere evaluation sees (docs/simulator.md)
+  double pretravel_um = 0, noise_um = 0;
+  Vector3d reported_tip_mm = Vector3d::Zero();  // latched, machine coordinates of the tip
+};
+
+class VirtualMachine : public gcode::MachineInterface {
+ public:
+  VirtualMachine(const parts::Machine& m, const parts::SphereArtifact& a, const MachineTruth& tr,
+                 std::uint64_t seed)
+      : m_(m), a_(a), tr_(tr), noise_rng_(streamSeed(seed, 1)), atc_rng_(streamSeed(seed, 2)),
+        sensor_rng_(streamSeed(seed, 3)), duty_rng_(streamSeed(seed, 4)) {
+    if (tr.thermal.present) {
+      T0_ = tr.thermal.environment.at(0.0);
+      net_ = ThermalNetwork(tr.thermal.nodes, tr.thermal.links, T0_);
+      std::uniform_real_distribution<double> u(-0.5, 0.5);
+      for (const auto& s : tr.thermal.sensors) sensor_offset_.push_back(s.offset_K ? *s.offset_K : u(sensor_rng_));
+    }
+    inputs_ << "# probeloop simulate: machine inputs sampled every " << formatNumber(tr.inputs_rate_s)
+            << " s (sensors with noise and offset)\n";
+    inputs_ << "time_s";
+    for (const auto& s : tr.thermal.sensors) inputs_ << "," << s.column;
+    inputs_ << ",c_rpm,spindle_rpm,mwf_on,tool_changes\n";
+    // At rest at the top of Z (the tool-change height region), X and Y at the C axis.
+    pos_.xyz_mm = Vector3d(std::clamp(m_.c_axis_centre_mm.x(), m_.x.min_mm, m_.x.max_mm),
+                           std::clamp(m_.c_axis_centre_mm.y(), m_.y.min_mm, m_.y.max_mm), m_.z.max_mm);
+    sample();
+  }
+
+  MachinePosition start() const override { return pos_; }
+
+  // --- gcode::MachineInterface ---------------------------------------------------------
+  void rapid(const MachinePosition& to) override {
+    checkTravel(to);
+    checkPath(to, "rapid (G0)");
+    double t = 0;
+    const Vector3d d = (to.xyz_mm - pos_.xyz_mm).cwiseAbs();
+    t = std::max(t, d.maxCoeff() / m_.rapid_feed_mm_per_min * 60.0);
+    t = std::max(t, rotaryTime(to.c_deg - pos_.c_deg, m_.c));
+    t = std::max(t, rotaryTime(to.b_deg - pos_.b_deg, m_.b));
+    advance(t);
+    pos_ = to;
+  }
+
+  void feed(const MachinePosition& to, double F) override {
+    checkTravel(to);
+    checkFeed(F);
+    checkPath(to, "feed move (G1/G2/G3)");
+    const double len = (to.xyz_mm - pos_.xyz_mm).norm();
+    const double rot = std::max(std::fabs(to.c_deg - pos_.c_deg), std::fabs(to.b_deg - pos_.b_deg));
+    advance((len > 0 ? len : rot) / F * 60.0);
+    pos_ = to;
+  }
+
+  gcode::ProbeOutcome probe(const MachinePosition& to, double F, gcode::ProbeMode mode) override {
+    checkTravel(to);
+    checkFeed(F);
+    if (to.c_deg != pos_.c_deg || to.b_deg != pos_.b_deg)
+      throw InputError("", 0, "a probe move with a rotary axis is not modelled");
+    const Vector3d g0 = pos_.xyz_mm, g1 = to.xyz_mm;
+    const double len = (g1 - g0).norm();
+    if (len <= 0) throw InputError("", 0, "a probe move of zero length");
+    const Vector3d dir = (g1 - g0) / len;
+    const Vector3d a = tipActual(g0), b = tipActual(g1);
+    const Artifact art = artifact();
+    // Stem and table first: a probe move may touch the sphere only.
+    const double s_contact = firstSphereContact(a, b, art);
+    const double s_end = s_contact >= 0 ? s_contact : 1.0;
+    checkStemAndTable(a, a + s_end * (b - a), art, "probe move");
+    gcode::ProbeOutcome out;
+    const double pre_um = pretravel(dir);
+    const double extra_mm = pre_um * 1e-3 + F / 60.0 * tr_.probe.trigger_delay_s;
+    const double s_trig = s_contact >= 0 ? s_contact + extra_mm / len : 2.0;
+    if (s_contact < 0 || s_trig > 1.0) {
+      // No trigger within the move: G38.2/G38.3 and G31 all end at the target.
+      advance(len / F * 60.0);
+      pos_ = to;
+      out.contact = false;
+      out.stop = to;
+      return out;
+    }
+    (void)mode;
+    ProbeEvent ev;
+    ev.c_deg = pos_.c_deg;
+    ev.approach = dir;
+    ev.pretravel_um = pre_um;
+    fillTruth(ev, art);
+    ev.noise_um = tr_.probe.noise_um > 0 ? tr_.probe.noise_um * normal_(noise_rng_) : 0.0;
+    Vector3d latched = g0 + s_trig * (g1 - g0) + ev.noise_um * 1e-3 * dir;
+    if (tr_.probe.quantise) {
+      const double q[3] = {m_.x.resolution_mm, m_.y.resolution_mm, m_.z.resolution_mm};
+      for (int k = 0; k < 3; ++k) latched(k) = std::round(latched(k) / q[k]) * q[k];
+    }
+    advance(s_trig * len / F * 60.0);
+    ev.time_s = t_;
+    ev.reported_tip_mm = latched - Vector3d(0, 0, currentToolLength());
+    events_.push_back(ev);
+    pending_ = static_cast<long>(events_.size()) - 1;
+    pos_.xyz_mm = latched;
+    out.contact = true;
+    out.stop = pos_;
+    return out;
+  }
+
+  void dwell(double s) override {
+    dwelling_ = true;
+    advance(s);
+    dwelling_ = false;
+  }
+
+  void toolChange(int tool) override {
+    const bool probe = tool == m_.probe.tool;
+    if (!probe && tool != m_.tool_change.empty_tool)
+      throw InputError("", 0, "tool T" + std::to_string(tool) + " is not in the machine's tool table (the "
+                              "simulator knows the probe T" + std::to_string(m_.probe.tool) +
+                              " and the empty spindle T" + std::to_string(m_.tool_change.empty_tool) + ")");
+    if (spindle_rpm_ != 0) throw SafetyError("tool change with the spindle turning (M5 first)");
+    advance(m_.tool_change.time_s);
+    ++tool_changes_;
+    tool_ = tool;
+    atc_um_.setZero();
+    if (probe && tr_.atc_repeatability_um > 0)
+      for (int k = 0; k < 3; ++k) atc_um_(k) = tr_.atc_repeatability_um * normal_(atc_rng_);
+  }
+
+  double toolLength(int tool) const override {
+    if (tool == m_.probe.tool) return m_.probe.length_mm;
+    if (tool == m_.tool_change.empty_tool) return 0.0;
+    throw InputError("", 0, "G43 H" + std::to_string(tool) + ": no such tool in the machine's tool table");
+  }
+
+  void spindle(double rpm) override {
+    if (rpm != 0 && tool_ == m_.probe.tool)
+      throw SafetyError("spindle start (M3/M4) with the touch probe in the spindle");
+    spindle_rpm_ = rpm;
+  }
+  void coolant(bool on) override { coolant_ = on; }
+  void openLog(const std::string& name) override { log_name_ = name; }
+  void log(const std::string& line) override {
+    log_ << line << "\n";
+    ++log_lines_;
+    if (pending_ >= 0) {
+      events_[static_cast<std::size_t>(pending_)].log_line = log_lines_;
+      pending_ = -1;
+    }
+  }
+  void closeLog() override {}
+
+  // --- results --------------------------------------------------------------------------
+  double time() const { return t_; }
+  std::string logText() const { return log_.str(); }
+  std::string inputsText() const { return inputs_.str(); }
+  const std::vector<ProbeEvent>& events() const { return events_; }
+  const std::string& logName() const { return log_name_; }
+  void finish() {
+    // A last sample at the end time, if the regular grid missed it.
+    if (last_sample_t_ < t_ - 1e-9) sample();
+  }
+
+ private:
+  const parts::Machine& m_;
+  const parts::SphereArtifact& a_;
+  const MachineTruth& tr_;
+  std::mt19937_64 noise_rng_, atc_rng_, sensor_rng_, duty_rng_;
+  std::normal_distribution<double> normal_{0.0, 1.0};
+  ThermalNetwork net_;
+  double T0_ = 20;
+  std::vector<double> sensor_offset_;
+  double t_ = 0;
+  long sample_index_ = 0;
+  double last_sample_t_ = -1;
+  MachinePosition pos_;
+  int tool_ = 0;
+  Vector3d atc_um_ = Vector3d::Zero();
+  double spindle_rpm_ = 0;
+  bool coolant_ = false, dwelling_ = false;
+  int tool_changes_ = 0;
+  std::vector<double> duty_levels_;  // random C levels per hold period, drawn as needed
+  std::ostringstream log_, inputs_;
+  long log_lines_ = 0, pending_ = -1;
+  std::string log_name_;
+  std::vector<ProbeEvent> events_;
+
+  struct Artifact {
+    Vector3d centre;      // actual sphere centre (tip coordinates)
+    double radius = 0;    // actual sphere radius
+    double stem_radius = 0;
+    double table_z = 0;
+    double dT = 0;
+    std::array<double, 7> location{};
+  };
+
+  // --- clock and thermal state ----------------------------------------------------------
+  static double rotaryTime(double delta_deg, const parts::RotaryAxis& ax) {
+    if (delta_deg == 0) return 0;
+    if (!ax.present || !(ax.max_speed_rpm > 0)) throw InputError("", 0, "move of a rotary axis the machine does not have");
+    return std::fabs(delta_deg) / (ax.max_speed_rpm * 360.0) * 60.0;
+  }
+
+  double cRpm(double t) {
+    if (!dwelling_) return 0;
+    const auto& d = tr_.duty;
+    if (!d.c_profile.empty()) {
+      double v = 0;
+      for (const auto& [at, rpm] : d.c_profile)
+        if (t >= at) v = rpm;
+      return v;
+    }
+    if (!d.c_levels_rpm.empty()) {
+      const auto k = static_cast<std::size_t>(std::floor(t / d.hold_s));
+      std::uniform_int_distribution<std::size_t> pick(0, d.c_levels_rpm.size() - 1);
+      while (duty_levels_.size() <= k) duty_levels_.push_back(d.c_levels_rpm[pick(duty_rng_)]);
+      return duty_levels_[k];
+    }
+    return 0;
+  }
+  bool mwfOn(double t) const {
+    bool on = coolant_;
+    for (const auto& [at, v] : tr_.duty.mwf_profile)
+      if (t >= at) on = v;
+    return on;
+  }
+
+  Eigen::VectorXd heat(double t) {
+    Eigen::VectorXd q = Eigen::VectorXd::Zero(net_.size());
+    for (const auto& s : tr_.thermal.sources) {
+      double v = 0;
+      switch (s.input) {
+        case HeatInput::CAxisRpm: v = std::fabs(cRpm(t)) * s.gain; break;
+        case HeatInput::SpindleRpm: v = std::fabs(spindle_rpm_) * s.gain; break;
+        case HeatInput::Mwf: v = mwfOn(t) ? s.gain : 0.0; break;
+        case HeatInput::Constant: v = s.gain; break;
+      }
+      q(s.node) += v;
+    }
+    return q;
+  }
+
+  void advance(double dt) {
+    const double rate = tr_.inputs_rate_s;
+    while (dt > 1e-12) {
+      const double next_sample = static_cast<double>(sample_index_) * rate;
+      double h = std::min(dt, tr_.thermal.max_step_s);
+      if (next_sample > t_ + 1e-9) h = std::min(h, next_sample - t_);
+      if (tr_.thermal.present) net_.advance(h, tr_.thermal.environment.at(t_ + h / 2), heat(t_ + h / 2));
+      t_ += h;
+      dt -= h;
+      if (std::fabs(t_ - next_sample) <= 1e-9 || t_ > next_sample) sample();
+    }
+  }
+
+  void sample() {
+    inputs_ << formatNumber(t_, 3);
+    for (std::size_t i = 0; i < tr_.thermal.sensors.size(); ++i) {
+      const auto& s = tr_.thermal.sensors[i];
+      const double T = s.node < 0 ? tr_.thermal.environment.at(t_) : net_.temperatures_C()(s.node);
+      const double noisy = T + sensor_offset_[i] + (s.noise_K > 0 ? s.noise_K * normal_(sensor_rng_) : 0.0);
+      inputs_ << "," << formatNumber(noisy, 3);
+    }
+    inputs_ << "," << formatNumber(cRpm(t_), 3) << "," << formatNumber(spindle_rpm_, 3) << ","
+            << (mwfOn(t_) ? 1 : 0) << "," << tool_changes_ << "\n";
+    tool_changes_ = 0;
+    last_sample_t_ = t_;
+    ++sample_index_;
+  }
+
+  double nodeRise(int node) const {
+    return node < 0 || !tr_.thermal.present ? 0.0 : net_.temperatures_C()(node) - T0_;
+  }
+
+  // --- where things really are ----------------------------------------------------------
+  Vector3d toolDriftUm() const {
+    Vector3d d(tr_.static_errors.tool_um[0], tr_.static_errors.tool_um[1], tr_.static_errors.tool_um[2]);
+    if (tr_.thermal.present)
+      for (int i = 0; i < net_.size(); ++i)
+        for (int k = 0; k < 3; ++k) d(k) += tr_.thermal.per_node_K[i].tool_um[k] * nodeRise(i);
+    return d + atc_um_;
+  }
+
+  std::array<double, 7> locationErrors() const {
+    auto v = tr_.static_errors.location;
+    const auto kf = tr_.keyframeAt(t_).values();
+    for (int j = 0; j < 7; ++j) v[j] += kf[j];
+    if (tr_.thermal.present)
+      for (int i = 0; i < net_.size(); ++i)
+        for (int j = 0; j < 7; ++j) v[j] += tr_.thermal.per_node_K[i].location[j] * nodeRise(i);
+    return v;
+  }
+
+  double currentToolLength() const { return toolLength(tool_); }
+  double tipRadius() const { return tool_ == m_.probe.tool ? m_.probe.tip_diameter_mm / 2 : 0.0; }
+
+  // Tool-side error of the tip (mm) at a commanded gauge-line position.
+  Vector3d toolError(const Vector3d& g) const {
+    Vector3d d = toolDriftUm() * 1e-3;
+    if (tr_.axes.any) {
+      const Vector3d lever(0, 0, -currentToolLength());  // gauge line -> tip
+      for (int ax = 0; ax < 3; ++ax) {
+        const auto& c = tr_.axes.coeff[ax];
+        const double p = g(ax);
+        Vector3d trans(poly(c[0], p), poly(c[1], p), poly(c[2], p));
+        Vector3d rot(poly(c[3], p), poly(c[4], p), poly(c[5], p));
+        d += trans * 1e-3 + (rot * 1e-6).cross(lever);
+      }
+    }
+    // Squareness as right-hand rotations of the Y and Z axes (docs/simulator.md).
+    d.x() += -tr_.EC0Y_urad * 1e-6 * g.y() + tr_.EB0Z_urad * 1e-6 * g.z();
+    d.y() += -tr_.EA0Z_urad * 1e-6 * g.z();
+    return d;
+  }
+
+  Vector3d tipActual(const Vector3d& gauge) const {
+    return gauge - Vector3d(0, 0, currentToolLength()) + toolError(gauge);
+  }
+
+  Artifact artifact() const {
+    Artifact art;
+    art.dT = nodeRise(tr_.artifact.node);
+    const double grow = 1.0 + tr_.artifact.alpha_per_K * art.dT;
+    const double sense = m_.c.positive_is_clockwise ? -1.0 : 1.0;
+    const double th = degToRad(a_.angle_at_c0_deg + sense * pos_.c_deg);
+    const double rot = degToRad(sense * pos_.c_deg);
+    const Vector3d& pe = tr_.artifact.placement_error_mm;
+    const Vector3d placement(std::cos(rot) * pe.x() - std::sin(rot) * pe.y(),
+                             std::sin(rot) * pe.x() + std::cos(rot) * pe.y(), pe.z());
+    const Vector3d nominal(m_.c_axis_centre_mm.x() + a_.radius_from_axis_mm * grow * std::cos(th),
+                           m_.c_axis_centre_mm.y() + a_.radius_from_axis_mm * grow * std::sin(th),
+                           m_.table_surface_z_mm + a_.centreHeightAboveTable() * grow);
+    art.location = locationErrors();
+    art.centre = geometry::displacedOnTable(nominal + placement, m_.c_axis_centre_mm,
+                                            geometry::LocationErrors::fromValues(art.location));
+    art.radius = a_.sphereRadius() * grow;
+    art.stem_radius = a_.stem_diameter_mm / 2;
+    art.table_z = m_.table_surface_z_mm;
+    return art;
+  }
+
+  // Smallest s in [0,1] where the tip sphere touches the artifact sphere while moving in;
+  // -1 if it does not.
+  double firstSphereContact(const Vector3d& a, const Vector3d& b, const Artifact& art) const {
+    const double Rt = art.radius + tipRadius();
+    const Vector3d d = b - a, w = a - art.centre;
+    const double A = d.squaredNorm(), B = d.dot(w), C = w.squaredNorm() - Rt * Rt;
+    if (C <= 0) return 0.0;  // already in contact at the start
+    const double disc = B * B - A * C;
+    if (disc < 0 || A == 0) return -1.0;
+    const double s = (-B - std::sqrt(disc)) / A;
+    return s >= 0 && s <= 1 ? s : -1.0;
+  }
+
+  void checkStemAndTable(const Vector3d& a, const Vector3d& b, const Artifact& art, const std::string& what) const {
+    const double r = tipRadius();
+    const Vector3d stem_top(art.centre.x(), art.centre.y(), art.centre.z() - art.radius);
+    const Vector3d stem_bottom(art.centre.x(), art.centre.y(), art.table_z);
+    if (segmentDistance(a, b, stem_bottom, stem_top) < art.stem_radius + r - 1e-9)
+      throw SafetyError(what + " would hit the artifact's stem");
+    if (std::min(a.z(), b.z()) - r < art.table_z - 1e-9)
+      throw SafetyError(what + " would hit the table: tip at Z " + formatNumber(std::min(a.z(), b.z()), 4) +
+                        " mm, radius " + formatNumber(r, 4) + " mm, table surface Z " + formatNumber(art.table_z, 4));
+  }
+
+  // A non-probing move must not touch anything.
+  void checkPath(const MachinePosition& to, const std::string& what) const {
+    if (to.c_deg != pos_.c_deg || to.b_deg != pos_.b_deg) {
+      // The table turns under a still tip: it must be clear of the sphere's circle.
+      const Artifact art = artifact();
+      const Vector3d tip = tipActual(pos_.xyz_mm);
+      if (tip.z() - tipRadius() < art.centre.z() + art.radius + 1e-9) {
+        const double r_tip = std::hypot(tip.x() - m_.c_axis_centre_mm.x(), tip.y() - m_.c_axis_centre_mm.y());
+        const double r_art = std::hypot(art.centre.x() - m_.c_axis_centre_mm.x(), art.centre.y() - m_.c_axis_centre_mm.y());
+        if (std::fabs(r_tip - r_art) < art.radius + tipRadius())
+          throw SafetyError(what + " turns the table while the tip is below the top of the sphere at its radius");
+      }
+      if (to.xyz_mm == pos_.xyz_mm) return;
+    }
+    const Artifact art = artifact();
+    const Vector3d a = tipActual(pos_.xyz_mm), b = tipActual(to.xyz_mm);
+    const double Rt = art.radius + tipRadius();
+    // After a trigger the stylus is deflected into the surface by pre-travel, delay and
+    // overshoot (< 0.5 mm); a move that leaves from there outward is the retract.
+    const bool retract = (a - art.centre).norm() > Rt - 0.5 && (a - art.centre).dot(b - a) >= 0;
+    if (!retract && segmentDistance(a, b, art.centre, art.centre) < Rt - 1e-9)
+      throw SafetyError(what + " would pass through the sphere artifact");
+    checkStemAndTable(a, b, art, what);
+  }
+
+  void checkFeed(double F) const {
+    const double fmax = std::min({m_.x.max_feed_mm_per_min, m_.y.max_feed_mm_per_min, m_.z.max_feed_mm_per_min});
+    if (F > fmax + 1e-9)
+      throw SafetyError("feed F" + formatNumber(F) + " exceeds the machine's maximum feed " + formatNumber(fmax) + " mm/min");
+  }
+
+  void checkTravel(const MachinePosition& to) const {
+    const parts::LinearAxis* ax[] = {&m_.x, &m_.y, &m_.z};
+    const char* names[] = {"X", "Y", "Z"};
+    for (int k = 0; k < 3; ++k)
+      if (to.xyz_mm(k) < ax[k]->min_mm - 1e-9 || to.xyz_mm(k) > ax[k]->max_mm + 1e-9)
+        throw SafetyError(std::string("move outside travel: ") + names[k] + " " + formatNumber(to.xyz_mm(k)) +
+                          " mm (gauge line, machine coordinates) is outside [" + formatNumber(ax[k]->min_mm) +
+                          ", " + formatNumber(ax[k]->max_mm) + "]");
+    if (to.b_deg != 0 && !m_.b.present) throw SafetyError("move of B on a machine without a B axis");
+    if (m_.b.present && (to.b_deg < m_.b.min_deg - 1e-9 || to.b_deg > m_.b.max_deg + 1e-9))
+      throw SafetyError("move outside travel: B " + formatNumber(to.b_deg) + " deg");
+    if (to.c_deg != 0 && !m_.c.present) throw SafetyError("move of C on a machine without a C axis");
+    if (m_.c.present && !m_.c.continuous && (to.c_deg < m_.c.min_deg - 1e-9 || to.c_deg > m_.c.max_deg + 1e-9))
+      throw SafetyError("move outside travel: C " + formatNumber(to.c_deg) + " deg");
+  }
+
+  double pretravel(const Vector3d& dir) const {
+    const auto& p = tr_.probe;
+    const double h = std::hypot(dir.x(), dir.y());
+    const double phi = std::atan2(dir.y(), dir.x());
+    const double lateral = p.pretravel_um + p.lobe_amplitude_um * std::cos(p.lobes * (phi - degToRad(p.lobe_phase_deg)));
+    return h * lateral + std::fabs(dir.z()) * p.pretravel_vertical_um;
+  }
+
+  void fillTruth(ProbeEvent& ev, const Artifact& art) const {
+    ev.location = art.location;
+    ev.tool_um = toolDriftUm();
+    ev.atc_um = atc_um_;
+    ev.artifact_dT_K = art.dT;
+    // What a sphere campaign evaluation sees: table errors minus the tool's translation,
+    // plus the artifact's own growth (radius from the axis and height).
+    ev.apparent = art.location;
+    const double a = tr_.artifact.alpha_per_K * art.dT;
+    ev.apparent[0] -= ev.tool_um.x();
+    ev.apparent[1] -= ev.tool_um.y();
+    ev.apparent[2] -= ev.tool_um.z();
+    // The ball grows too; the known-radius fit reads that as a lift of the centre by the
+    // radius change, because only the top point sees Z (docs/simulator.md).
+    ev.apparent[2] += a * (a_.centreHeightAboveTable() + a_.sphereRadius()) * 1e3;
+    ev.apparent[3] += a * a_.radius_from_axis_mm * 1e3;
+  }
+};
+
+}  // namespace
+
+SimulationOutputs simulateProgram(const std::string& program_file, const std::string& text,
+                                  const parts::Machine& machine, const parts::SphereArtifact& part,
+                                  const MachineTruth& truth, std::uint64_t seed) {
+  const std::string ext = std::filesystem::path(program_file).extension().string();
+  gcode::ProgramDialect dialect = machine.dialect == parts::Dialect::LinuxCnc ? gcode::ProgramDialect::LinuxCnc
+                                                                              : gcode::ProgramDialect::FanucMacroB;
+  if (ext == ".ngc") dialect = gcode::ProgramDialect::LinuxCnc;
+  if (ext == ".nc" || ext == ".tap") dialect = gcode::ProgramDialect::FanucMacroB;
+  gcode::Interpreter interp(dialect, program_file, text);
+  VirtualMachine vm(machine, part, truth, seed);
+  const auto run = interp.run(vm);
+  vm.finish();
+
+  SimulationOutputs out;
+  out.blocks = run.blocks_executed;
+  out.end_time_s = vm.time();
+  out.log_text = vm.logText();
+  out.log_name = vm.logName().empty() || dialect == gcode::ProgramDialect::FanucMacroB ? "dprnt.txt" : vm.logName();
+  out.inputs_csv = vm.inputsText();
+  const auto& events = vm.events();
+  out.probe_events = static_cast<long>(events.size());
+
+  // Canonical points: the logged points (as reported) joined with the event behind each.
+  std::map<long, const ProbeEvent*> by_line;
+  for (const auto& e : events)
+    if (e.log_line > 0) by_line[e.log_line] = &e;
+  const auto logged = gcode::parseProbeLog(out.log_text, out.log_name);
+  std::ostringstream csv;
+  csv << "# probeloop simulate " << program_file << ", seed " << seed << "\n";
+  csv << "time_s,cycle,c_deg,feature,point,x_mm,y_mm,z_mm,nx,ny,nz\n";
+  nlohmann::ordered_json jt;
+  jt["format"] = "probeloop-truth";
+  jt["generator"] = "probeloop simulate";
+  jt["seed"] = seed;
+  jt["relative_to_cycle"] = 1;
+  jt["note"] = "apparent_* = table-side location errors minus the tool-side translation plus the artifact's "
+               "growth: what a sphere-artifact evaluation measures (docs/simulator.md)";
+  std::map<int, std::pair<int, std::array<double, 7>>> per_cycle;  // cycle -> (n, sum)
+  std::map<int, double> cycle_time;
+  const auto& names = geometry::LocationErrors::names();
+  for (const auto& p : logged) {
+    const auto it = by_line.find(p.line);
+    if (it == by_line.end())
+      throw InputError(out.log_name, p.line, "log line without a probe event (the program logged without probing)");
+    const ProbeEvent& e = *it->second;
+    csv << formatNumber(e.time_s, 3) << "," << p.cycle << "," << formatNumber(e.c_deg) << ",S" << p.position << ","
+        << p.point << "," << formatNumber(e.reported_tip_mm.x()) << "," << formatNumber(e.reported_tip_mm.y())
+        << "," << formatNumber(e.reported_tip_mm.z()) << ","
+        << formatNumber(e.approach.x(), 6) << "," << formatNumber(e.approach.y(), 6) << ","
+        << formatNumber(e.approach.z(), 6) << "\n";
+    nlohmann::ordered_json je{{"time_s", e.time_s}, {"log_line", e.log_line}, {"cycle", p.cycle},
+                              {"position", p.position}, {"point", p.point}, {"c_deg", e.c_deg}};
+    for (int j = 0; j < 7; ++j) je[names[j]] = e.location[j];
+    je["tool_um"] = {e.tool_um.x(), e.tool_um.y(), e.tool_um.z()};
+    je["atc_um"] = {e.atc_um.x(), e.atc_um.y(), e.atc_um.z()};
+    je["artifact_dT_K"] = e.artifact_dT_K;
+    je["pretravel_um"] = e.pretravel_um;
+    je["noise_um"] = e.noise_um;
+    for (int j = 0; j < 7; ++j) je[std::string("apparent_") + names[j]] = e.apparent[j];
+    jt["events"].push_back(je);
+    auto& acc = per_cycle[p.cycle];
+    if (acc.first == 0) cycle_time[p.cycle] = e.time_s;
+    ++acc.first;
+    for (int j = 0; j < 7; ++j) acc.second[j] += e.apparent[j];
+  }
+  if (!per_cycle.empty()) {
+    const auto& ref = per_cycle.begin()->second;
+    for (const auto& [cyc, acc] : per_cycle) {
+      nlohmann::ordered_json jc{{"cycle", cyc}, {"time_s", cycle_time[cyc]}};
+      for (int j = 0; j < 7; ++j) jc[names[j]] = acc.second[j] / acc.first - ref.second[j] / ref.first;
+      jt["cycles"].push_back(jc);
+    }
+  }
+  out.points_csv = csv.str();
+  out.truth_json = jt.dump(1) + "\n";
+  return out;
+}
+
+}  // namespace probeloop::sim
