@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # The main job on the shipped example: plan the sphere-artifact cycle for the thesis's
-# machine (seed 004), run it on the test generator with known C-axis location errors,
-# evaluate the log, and write the glTF scene. Outputs in out/demo/.
+# machine (seed 004), run the emitted program on the virtual machine (thermal network, C-axis
+# duty, day/night hall, probe physics, tool changes: examples/truth_campaign.yaml), evaluate
+# the controller log, compare with the injected truth, and write the glTF scene.
+# Outputs in out/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh
@@ -14,15 +16,19 @@ $PL plan parts/sphere_artifact.yaml --machine parts/machines/nmv5000.yaml --out 
 $PL plan parts/sphere_artifact.yaml --machine parts/machines/linuxcnc_rotary_mill.yaml --out "$OUT/plan-linuxcnc" >/dev/null
 echo "   (also the LinuxCNC program: $OUT/plan-linuxcnc/sphere_cycle.ngc)"
 echo
-echo "== 2. synth: the cycle on a machine whose C axis drifts (examples/truth_rigid.yaml) =="
-$PL synth "$OUT/plan/plan.json" --truth examples/truth_rigid.yaml --out "$OUT/run" --seed 1
+echo "== 2. simulate: the Fanuc program on the virtual machine (examples/truth_campaign.yaml) =="
+$PL simulate "$OUT/plan/sphere_cycle.nc" --machine parts/machines/nmv5000.yaml --part parts/sphere_artifact.yaml \
+  --truth examples/truth_campaign.yaml --out "$OUT/run" --seed 1
+$PL simulate "$OUT/plan-linuxcnc/sphere_cycle.ngc" --machine parts/machines/linuxcnc_rotary_mill.yaml \
+  --part parts/sphere_artifact.yaml --truth examples/truth_campaign.yaml --out "$OUT/run-linuxcnc" --seed 1 >/dev/null
+echo "   (also the LinuxCNC program on the LinuxCNC mill: $OUT/run-linuxcnc/sphere_probe.log)"
 echo
 echo "== 3. evaluate: the Fanuc DPRNT log -> location errors with U (k=2) =="
-$PL evaluate "$OUT/run/sphere_probe_dprnt.txt" --format fanuc --manifest "$OUT/plan/plan.json" \
+$PL evaluate "$OUT/run/dprnt.txt" --format fanuc --manifest "$OUT/plan/plan.json" \
   --out "$OUT/eval" --scene "$OUT/eval/campaign.gltf"
 echo
-echo "== 4. compare with the injected truth =="
-python3 tests/integration/compare_errors.py "$OUT/eval/errors.csv" "$OUT/run/truth.json" 0 0 --within-U \
-  && echo "   every value lies within its expanded uncertainty of the injected truth"
+echo "== 4. compare with the injected truth (truth.json: what the simulator put in) =="
+python3 tests/integration/compare_errors.py "$OUT/eval/errors.csv" "$OUT/run/truth.json" 0 0 --coverage
 echo
-echo "Outputs: $OUT/plan (G-code, manifest), $OUT/run (logs, truth), $OUT/eval (errors.csv, evaluation.json, campaign.gltf)"
+echo "Outputs: $OUT/plan (G-code, manifest), $OUT/run (controller log, points.csv, inputs.csv, truth.json),"
+echo "         $OUT/eval (errors.csv, evaluation.json, campaign.gltf)"

@@ -542,6 +542,9 @@ SimulationOutputs simulateProgram(const std::string& program_file, const std::st
   jt["relative_to_cycle"] = 1;
   jt["note"] = "apparent_* = table-side location errors minus the tool-side translation plus the artifact's "
                "growth: what a sphere-artifact evaluation measures (docs/simulator.md)";
+  // Quantised reports are whole resolution steps: print them as the decimals they are (6
+  // for 1 um); unquantised ones at full precision (shortest round trip).
+  const int decimals = truth.probe.quantise ? 6 : -1;
   std::map<int, std::pair<int, std::array<double, 7>>> per_cycle;  // cycle -> (n, sum)
   std::map<int, double> cycle_time;
   const auto& names = geometry::LocationErrors::names();
@@ -551,8 +554,8 @@ SimulationOutputs simulateProgram(const std::string& program_file, const std::st
       throw InputError(out.log_name, p.line, "log line without a probe event (the program logged without probing)");
     const ProbeEvent& e = *it->second;
     csv << formatNumber(e.time_s, 3) << "," << p.cycle << "," << formatNumber(e.c_deg) << ",S" << p.position << ","
-        << p.point << "," << formatNumber(e.reported_tip_mm.x()) << "," << formatNumber(e.reported_tip_mm.y())
-        << "," << formatNumber(e.reported_tip_mm.z()) << ","
+        << p.point << "," << formatNumber(e.reported_tip_mm.x(), decimals) << ","
+        << formatNumber(e.reported_tip_mm.y(), decimals) << "," << formatNumber(e.reported_tip_mm.z(), decimals) << ","
         << formatNumber(e.approach.x(), 6) << "," << formatNumber(e.approach.y(), 6) << ","
         << formatNumber(e.approach.z(), 6) << "\n";
     nlohmann::ordered_json je{{"time_s", e.time_s}, {"log_line", e.log_line}, {"cycle", p.cycle},

@@ -110,6 +110,47 @@ else
   bad "gltf-validator not installed (run scripts/setup.sh)"
 fi
 
+# --- the virtual machine: the emitted programs run, the evaluation finds the truth --------
+LCNC_PLAN="$W/lc"; FA_PLAN="$W/p"
+CAMP=$SRC/examples/truth_campaign.yaml
+check "simulate runs the Fanuc program" "$PL" simulate "$FA_PLAN/sphere_cycle.nc" --machine "$NMV" --part "$ART" --truth "$CAMP" --out "$W/v" --seed 3
+"$PL" evaluate "$W/v/dprnt.txt" --format fanuc --manifest "$FA_PLAN/plan.json" --out "$W/v/e" > /dev/null
+check "simulated Fanuc campaign: truth recovered within U (coverage)" python3 "$SRC/tests/integration/compare_errors.py" "$W/v/e/errors.csv" "$W/v/truth.json" 0 0 --coverage
+"$PL" evaluate "$W/v/points.csv" --manifest "$FA_PLAN/plan.json" --out "$W/v/c" > /dev/null
+# The CSV carries the trigger times, the log does not (planned times): compare without them.
+check "simulated points CSV and DPRNT log agree (1 um quantised)" cmp <(cut -d, -f2- "$W/v/e/errors.csv") <(cut -d, -f2- "$W/v/c/errors.csv")
+check "simulate runs the LinuxCNC program" "$PL" simulate "$LCNC_PLAN/sphere_cycle.ngc" --machine "$LCNC" --part "$W/art2.yaml" --truth "$CAMP" --out "$W/vl" --seed 3
+"$PL" evaluate "$W/vl/sphere_probe.log" --manifest "$LCNC_PLAN/plan.json" --out "$W/vl/e" > /dev/null
+check "simulated LinuxCNC campaign: truth recovered within U (coverage)" python3 "$SRC/tests/integration/compare_errors.py" "$W/vl/e/errors.csv" "$W/vl/truth.json" 0 0 --coverage
+check "inputs CSV has the sensors and machine state" grep -q '^time_s,T_env_C,T_caxis_C,T_table_C,c_rpm,spindle_rpm,mwf_on,tool_changes$' "$W/v/inputs.csv"
+"$PL" simulate "$FA_PLAN/sphere_cycle.nc" --machine "$NMV" --part "$ART" --truth "$CAMP" --out "$W/v2" --seed 3 > /dev/null
+check "simulate: same seed, byte-identical outputs" bash -c "cmp '$W/v/dprnt.txt' '$W/v2/dprnt.txt' && cmp '$W/v/inputs.csv' '$W/v2/inputs.csv' && cmp '$W/v/truth.json' '$W/v2/truth.json' && cmp '$W/v/points.csv' '$W/v2/points.csv'"
+# A hidden rigid truth, no noise: the simulated campaign recovers it like the generator does.
+cat > "$W/rigid_vm.yaml" <<Y
+kind: machine_truth
+location_keyframes:
+  - {time: 0 s}
+  - {time: 1 h, EX0C_um: 3, EY0C_um: -4, EZ0T_um: 6, ER0T_um: 2.5, EA0C_urad: 15, EB0C_urad: -20, EC0C_urad: 35}
+Y
+"$PL" simulate "$FA_PLAN/sphere_cycle.nc" --machine "$NMV" --part "$ART" --truth "$W/rigid_vm.yaml" --out "$W/vr" > /dev/null
+"$PL" evaluate "$W/vr/points.csv" --manifest "$FA_PLAN/plan.json" --out "$W/vr/e" > /dev/null
+# Tolerance: the errors drift during cycle 1 (the reference), and the spheres are probed
+# ~24 s apart, so a drift reads partly as another error: EZ0T moves 6 um/h x 48 s = 0.08 um
+# between positions 2 and 4, a false tilt of 0.08 um / 320 mm = 0.25 urad; EX0C/EY0C move
+# < 4 um/h x 48 s = 0.05 um. Bounds 0.06 um and 0.3 urad.
+check "simulated rigid drift recovered (no noise)" python3 "$SRC/tests/integration/compare_errors.py" "$W/vr/e/errors.csv" "$W/vr/truth.json" 0.06 0.3
+# Bad input to simulate: the file and line, exit != 0, nothing written.
+sed 's/^G0 C/G0 Q1 C/' "$FA_PLAN/sphere_cycle.nc" > "$W/badword.nc"
+line=$(grep -n 'Q1' "$W/badword.nc" | head -1 | cut -d: -f1)
+refuses "unknown G-code word names the program line" "badword.nc:$line: word 'Q' is not modelled" "$PL" simulate "$W/badword.nc" --machine "$NMV" --part "$ART" --truth "$CAMP" --out "$W/sx"
+sed 's/^probe:/prob:/' "$CAMP" > "$W/badtruth.yaml"
+refuses "unknown truth key names file:line" "badtruth.yaml:[0-9]+: unknown key 'prob'" "$PL" simulate "$FA_PLAN/sphere_cycle.nc" --machine "$NMV" --part "$ART" --truth "$W/badtruth.yaml" --out "$W/sx"
+sed 's/node: table, alpha/node: tabel, alpha/' "$CAMP" > "$W/badnode.yaml"
+refuses "unknown thermal node is named" "no thermal node named 'tabel'" "$PL" simulate "$FA_PLAN/sphere_cycle.nc" --machine "$NMV" --part "$ART" --truth "$W/badnode.yaml" --out "$W/sx"
+sed 's/radius_from_c_axis: 160 mm/radius_from_c_axis: 150 mm/' "$ART" > "$W/moved.yaml"
+refuses "artifact not where the program expects: the program's own alarm" "#3000=2 \(UNEXPECTED CONTACT\)" "$PL" simulate "$FA_PLAN/sphere_cycle.nc" --machine "$NMV" --part "$W/moved.yaml" --truth "$CAMP" --out "$W/sx"
+check "nothing written by refused simulations" test ! -e "$W/sx"
+
 # --- bad input: clear message, non-zero exit, nothing half-written ------------------------
 sed 's/  approach: 3 mm/  approach: 3 mm\n  aproach: 3 mm/' "$ART" | sed 's/\\n/\n/' > "$W/unknown.yaml"
 refuses "unknown YAML key names file:line" "unknown.yaml:19: unknown key 'probing.aproach'" "$PL" plan "$W/unknown.yaml" --machine "$NMV" --out "$W/x"
