@@ -17,6 +17,7 @@
 #include "parts/machine.hpp"
 #include "parts/plan_manifest.hpp"
 #include "parts/sphere_artifact.hpp"
+#include "parts/workpiece.hpp"
 #include "planner/sphere_cycle.hpp"
 #include "report/scene.hpp"
 #include "sim/rigid_campaign.hpp"
@@ -99,21 +100,43 @@ int cmdSynth(const std::string& manifest_file, const std::string& truth_file,
 
 int cmdSimulate(const std::string& program_file, const std::string& machine_file,
                 const std::string& part_file, const std::string& truth_file, const std::string& out_dir,
-                std::uint64_t seed) {
+                std::uint64_t seed, const std::string& cmm_file) {
   const auto machine = parts::loadMachine(machine_file);
-  const auto part = parts::loadSphereArtifact(part_file);
   const auto truth = sim::loadMachineTruth(truth_file);
+  const std::string kind = parts::partKind(part_file);
+  std::optional<parts::SphereArtifact> artifact;
+  std::optional<parts::Workpiece> workpiece;
+  sim::SimulationPart part;
+  if (kind == "sphere_artifact") {
+    artifact = parts::loadSphereArtifact(part_file);
+    part.artifact = &*artifact;
+  } else if (kind == "workpiece") {
+    workpiece = parts::loadWorkpiece(part_file);
+    part.workpiece = &*workpiece;
+  } else {
+    throw InputError(part_file, 1, "kind: '" + kind + "' cannot stand on the simulated table (sphere_artifact or workpiece)");
+  }
+  if (!cmm_file.empty()) part.cmm_points = sim::readCmmPoints(cmm_file);
   const auto s = sim::simulateProgram(program_file, readFile(program_file), machine, part, truth, seed);
   const std::string log_file = fs::path(s.log_name).filename().string();
   writeFileAtomic(join(out_dir, log_file), s.log_text);
   writeFileAtomic(join(out_dir, "points.csv"), s.points_csv);
   writeFileAtomic(join(out_dir, "inputs.csv"), s.inputs_csv);
   writeFileAtomic(join(out_dir, "truth.json"), s.truth_json);
+  std::string extra;
+  if (workpiece) {
+    writeFileAtomic(join(out_dir, "cuts.json"), s.cuts_json);
+    extra += ", cuts.json";
+  }
+  if (!s.cmm_csv.empty()) {
+    writeFileAtomic(join(out_dir, "cmm_export.csv"), s.cmm_csv);
+    extra += ", cmm_export.csv";
+  }
   std::printf("Simulated %s on %s (seed %llu): %ld blocks, %ld probe events, %.1f h of machine time\n",
               program_file.c_str(), machine.name.c_str(), static_cast<unsigned long long>(seed), s.blocks,
               s.probe_events, s.end_time_s / 3600.0);
-  std::printf("  wrote %s (controller log), points.csv, inputs.csv, truth.json in %s\n", log_file.c_str(),
-              out_dir.c_str());
+  std::printf("  wrote %s (controller log), points.csv, inputs.csv, truth.json%s in %s\n", log_file.c_str(),
+              extra.c_str(), out_dir.c_str());
   return 0;
 }
 
@@ -245,10 +268,13 @@ int main(int argc, char** argv) {
   auto* simc = app.add_subcommand("simulate", "Run an emitted program on a virtual machine with known error effects");
   simc->add_option("program", program, "G-code program (.ngc LinuxCNC, .nc Fanuc macro B)")->required()->check(CLI::ExistingFile);
   simc->add_option("--machine", machine, "machine description (YAML)")->required()->check(CLI::ExistingFile);
-  simc->add_option("--part", part, "the sphere artifact on the table (YAML)")->required()->check(CLI::ExistingFile);
+  std::string cmm_points;
+  simc->add_option("--part", part, "what stands on the table: a sphere artifact or a workpiece (YAML)")->required()->check(CLI::ExistingFile);
   simc->add_option("--truth", truth, "the machine's error effects (YAML, kind: machine_truth)")->required()->check(CLI::ExistingFile);
   simc->add_option("--out", out, "output folder")->capture_default_str();
   simc->add_option("--seed", seed, "random seed")->capture_default_str();
+  simc->add_option("--cmm-points", cmm_points, "workpiece: CMM points to measure after the program "
+                   "(feature,point,x_mm,y_mm,z_mm,nx,ny,nz)")->check(CLI::ExistingFile);
 
   auto* ev = app.add_subcommand("evaluate", "Location errors of the C axis from probe logs or points CSV");
   ev->add_option("points", points, "LinuxCNC log, Fanuc DPRNT output or points CSV")->required()->check(CLI::ExistingFile);
@@ -286,7 +312,7 @@ int main(int argc, char** argv) {
     if (*plan) return cmdPlan(artifact, machine, out, dialect);
     if (*res) return cmdResolution(artifact, machine, step_um);
     if (*syn) return cmdSynth(manifest, truth, out, seed);
-    if (*simc) return cmdSimulate(program, machine, part, truth, out, seed);
+    if (*simc) return cmdSimulate(program, machine, part, truth, out, seed, cmm_points);
     if (*fit) return cmdFit(fa);
     if (*ev) return cmdEvaluate(points, manifest, out, format, free_radius, scene, exaggeration);
   } catch (const std::exception& e) {

@@ -285,6 +285,14 @@ MachineTruth loadMachineTruth(const std::string& path) {
     }
     a->finish();
   }
+  if (auto st = root.mapIfPresent("structure")) {
+    const char* keys[] = {"stiffness_x_N_per_um", "stiffness_y_N_per_um", "stiffness_z_N_per_um"};
+    for (int k = 0; k < 3; ++k) {
+      t.stiffness_N_per_um(k) = st->numberOr(keys[k], 0);
+      if (t.stiffness_N_per_um(k) < 0) st->fail(keys[k], "must not be negative (0 = rigid)");
+    }
+    st->finish();
+  }
   t.inputs_rate_s = root.quantityOr("inputs_rate", Dimension::Duration, 60);
   if (!(t.inputs_rate_s > 0)) root.fail("inputs_rate", "must be positive");
   root.finish();

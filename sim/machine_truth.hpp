@@ -120,6 +120,9 @@ struct MachineTruth {
   double atc_repeatability_um = 0;  // 1 sigma per axis of the tip after each tool change
   ArtifactTruth artifact;
   double inputs_rate_s = 60;        // inputs CSV sample period
+  // Static stiffness of the structure at the tool (seed 003: F/k), N/um per machine axis;
+  // 0 = rigid.
+  Eigen::Vector3d stiffness_N_per_um = Eigen::Vector3d::Zero();
 
   geometry::LocationErrors keyframeAt(double t_s) const;
 };

@@ -13,6 +13,7 @@
 #include "core/error.hpp"
 #include "core/units.hpp"
 #include "gcode/probe_log.hpp"
+#include "sim/material_removal.hpp"
 
 namespace probeloop::sim {
 
@@ -76,9 +77,9 @@ struct ProbeEvent {
 
 class VirtualMachine : public gcode::MachineInterface {
  public:
-  VirtualMachine(const parts::Machine& m, const parts::SphereArtifact& a, const MachineTruth& tr,
+  VirtualMachine(const parts::Machine& m, const SimulationPart& part, const MachineTruth& tr,
                  std::uint64_t seed)
-      : m_(m), a_(a), tr_(tr), noise_rng_(streamSeed(seed, 1)), atc_rng_(streamSeed(seed, 2)),
+      : m_(m), a_(part.artifact), w_(part.workpiece), tr_(tr), noise_rng_(streamSeed(seed, 1)), atc_rng_(streamSeed(seed, 2)),
         sensor_rng_(streamSeed(seed, 3)), duty_rng_(streamSeed(seed, 4)) {
     if (tr.thermal.present) {
       T0_ = tr.thermal.environment.at(0.0);
@@ -91,6 +92,7 @@ class VirtualMachine : public gcode::MachineInterface {
     inputs_ << "time_s";
     for (const auto& s : tr.thermal.sensors) inputs_ << "," << s.column;
     inputs_ << ",c_rpm,spindle_rpm,mwf_on,tool_changes\n";
+    if (w_) stock_ = Stock(w_->stock_min_mm, w_->stock_max_mm);
     // At rest at the top of Z (the tool-change height region), X and Y at the C axis.
     pos_.xyz_mm = Vector3d(std::clamp(m_.c_axis_centre_mm.x(), m_.x.min_mm, m_.x.max_mm),
                            std::clamp(m_.c_axis_centre_mm.y(), m_.y.min_mm, m_.y.max_mm), m_.z.max_mm);
@@ -115,7 +117,11 @@ class VirtualMachine : public gcode::MachineInterface {
   void feed(const MachinePosition& to, double F) override {
     checkTravel(to);
     checkFeed(F);
-    checkPath(to, "feed move (G1/G2/G3)");
+    if (w_ && isCutter() && spindle_rpm_ != 0) {
+      cutMove(to, F);
+      return;
+    }
+    checkPath(to, spindle_rpm_ == 0 && isCutter() ? "feed move (G1/G2/G3) with the spindle stopped" : "feed move (G1/G2/G3)");
     const double len = (to.xyz_mm - pos_.xyz_mm).norm();
     const double rot = std::max(std::fabs(to.c_deg - pos_.c_deg), std::fabs(to.b_deg - pos_.b_deg));
     advance((len > 0 ? len : rot) / F * 60.0);
@@ -131,6 +137,7 @@ class VirtualMachine : public gcode::MachineInterface {
     const double len = (g1 - g0).norm();
     if (len <= 0) throw InputError("", 0, "a probe move of zero length");
     const Vector3d dir = (g1 - g0) / len;
+    if (!a_) return probeWorkpiece(to, F, dir, len);
     const Vector3d a = tipActual(g0), b = tipActual(g1);
     const Artifact art = artifact();
     // Stem and table first: a probe move may touch the sphere only.
@@ -180,10 +187,11 @@ class VirtualMachine : public gcode::MachineInterface {
 
   void toolChange(int tool) override {
     const bool probe = tool == m_.probe.tool;
-    if (!probe && tool != m_.tool_change.empty_tool)
+    if (!probe && tool != m_.tool_change.empty_tool && !(w_ && w_->tool(tool)))
       throw InputError("", 0, "tool T" + std::to_string(tool) + " is not in the machine's tool table (the "
                               "simulator knows the probe T" + std::to_string(m_.probe.tool) +
-                              " and the empty spindle T" + std::to_string(m_.tool_change.empty_tool) + ")");
+                              " and the empty spindle T" + std::to_string(m_.tool_change.empty_tool) +
+                              ", plus the workpiece's tools)");
     if (spindle_rpm_ != 0) throw SafetyError("tool change with the spindle turning (M5 first)");
     advance(m_.tool_change.time_s);
     ++tool_changes_;
@@ -196,6 +204,8 @@ class VirtualMachine : public gcode::MachineInterface {
   double toolLength(int tool) const override {
     if (tool == m_.probe.tool) return m_.probe.length_mm;
     if (tool == m_.tool_change.empty_tool) return 0.0;
+    if (w_)
+      if (const auto* t = w_->tool(tool)) return t->length_mm;
     throw InputError("", 0, "G43 H" + std::to_string(tool) + ": no such tool in the machine's tool table");
   }
 
@@ -229,7 +239,10 @@ class VirtualMachine : public gcode::MachineInterface {
 
  private:
   const parts::Machine& m_;
-  const parts::SphereArtifact& a_;
+  const parts::SphereArtifact* a_;
+  const parts::Workpiece* w_;
+  Stock stock_;
+  nlohmann::ordered_json cuts_ = nlohmann::ordered_json::array();
   const MachineTruth& tr_;
   std::mt19937_64 noise_rng_, atc_rng_, sensor_rng_, duty_rng_;
   std::normal_distribution<double> normal_{0.0, 1.0};
@@ -358,7 +371,13 @@ class VirtualMachine : public gcode::MachineInterface {
   }
 
   double currentToolLength() const { return toolLength(tool_); }
-  double tipRadius() const { return tool_ == m_.probe.tool ? m_.probe.tip_diameter_mm / 2 : 0.0; }
+  double tipRadius() const {
+    if (tool_ == m_.probe.tool) return m_.probe.tip_diameter_mm / 2;
+    if (const auto* t = cutter()) return t->diameter_mm / 2;
+    return 0.0;
+  }
+  const parts::CuttingTool* cutter() const { return w_ ? w_->tool(tool_) : nullptr; }
+  bool isCutter() const { return cutter() != nullptr; }
 
   // Tool-side error of the tip (mm) at a commanded gauge-line position.
   Vector3d toolError(const Vector3d& g) const {
@@ -388,19 +407,19 @@ class VirtualMachine : public gcode::MachineInterface {
     art.dT = nodeRise(tr_.artifact.node);
     const double grow = 1.0 + tr_.artifact.alpha_per_K * art.dT;
     const double sense = m_.c.positive_is_clockwise ? -1.0 : 1.0;
-    const double th = degToRad(a_.angle_at_c0_deg + sense * pos_.c_deg);
+    const double th = degToRad(a_->angle_at_c0_deg + sense * pos_.c_deg);
     const double rot = degToRad(sense * pos_.c_deg);
     const Vector3d& pe = tr_.artifact.placement_error_mm;
     const Vector3d placement(std::cos(rot) * pe.x() - std::sin(rot) * pe.y(),
                              std::sin(rot) * pe.x() + std::cos(rot) * pe.y(), pe.z());
-    const Vector3d nominal(m_.c_axis_centre_mm.x() + a_.radius_from_axis_mm * grow * std::cos(th),
-                           m_.c_axis_centre_mm.y() + a_.radius_from_axis_mm * grow * std::sin(th),
-                           m_.table_surface_z_mm + a_.centreHeightAboveTable() * grow);
+    const Vector3d nominal(m_.c_axis_centre_mm.x() + a_->radius_from_axis_mm * grow * std::cos(th),
+                           m_.c_axis_centre_mm.y() + a_->radius_from_axis_mm * grow * std::sin(th),
+                           m_.table_surface_z_mm + a_->centreHeightAboveTable() * grow);
     art.location = locationErrors();
     art.centre = geometry::displacedOnTable(nominal + placement, m_.c_axis_centre_mm,
                                             geometry::LocationErrors::fromValues(art.location));
-    art.radius = a_.sphereRadius() * grow;
-    art.stem_radius = a_.stem_diameter_mm / 2;
+    art.radius = a_->sphereRadius() * grow;
+    art.stem_radius = a_->stem_diameter_mm / 2;
     art.table_z = m_.table_surface_z_mm;
     return art;
   }
@@ -431,6 +450,8 @@ class VirtualMachine : public gcode::MachineInterface {
 
   // A non-probing move must not touch anything.
   void checkPath(const MachinePosition& to, const std::string& what) const {
+    if (w_) return checkWorkpiecePath(to, what);
+    if (!a_) return;
     if (to.c_deg != pos_.c_deg || to.b_deg != pos_.b_deg) {
       // The table turns under a still tip: it must be clear of the sphere's circle.
       const Artifact art = artifact();
@@ -484,6 +505,177 @@ class VirtualMachine : public gcode::MachineInterface {
     return h * lateral + std::fabs(dir.z()) * p.pretravel_vertical_um;
   }
 
+
+  // --- the workpiece --------------------------------------------------------------------
+  // Machine coordinates of a point (tip coordinates) -> the workpiece frame at 20 °C: undo
+  // the table's location errors (two fixed-point steps), turn back to C = 0, undo the
+  // workpiece's expansion about its datum.
+  Vector3d toWorkpiece(const Vector3d& q) const {
+    const auto e = geometry::LocationErrors::fromValues(locationErrors());
+    Vector3d p = q;
+    for (int k = 0; k < 2; ++k) p = q - (geometry::displacedOnTable(p, m_.c_axis_centre_mm, e) - p);
+    const double sense = m_.c.positive_is_clockwise ? -1.0 : 1.0;
+    const double a = -degToRad(sense * pos_.c_deg);
+    const Eigen::Vector2d c = m_.c_axis_centre_mm, d = p.head<2>() - c;
+    p.head<2>() = c + Eigen::Vector2d(std::cos(a) * d.x() - std::sin(a) * d.y(), std::sin(a) * d.x() + std::cos(a) * d.y());
+    return w_->datum() + (p - w_->datum()) / (1.0 + tr_.artifact.alpha_per_K * workpieceAbove20K());
+  }
+  // The workpiece's temperature above 20 °C, where the CMM measures it.
+  double workpieceAbove20K() const {
+    return tr_.artifact.node >= 0 && tr_.thermal.present ? net_.temperatures_C()(tr_.artifact.node) - 20.0 : 0.0;
+  }
+  // A direction in the workpiece frame -> machine frame (rotation by C only).
+  Vector3d workpieceDirToMachine(const Vector3d& v) const {
+    const double sense = m_.c.positive_is_clockwise ? -1.0 : 1.0;
+    const double a = degToRad(sense * pos_.c_deg);
+    return Vector3d(std::cos(a) * v.x() - std::sin(a) * v.y(), std::sin(a) * v.x() + std::cos(a) * v.y(), v.z());
+  }
+
+  // Does the tool at gauge position g sit in material (height field)? For a flat end mill
+  // the bottom disk; for the probe the tip ball's lower part (reach r/2, 0.866 r below).
+  bool inMaterial(const Vector3d& g) const {
+    const Vector3d w = toWorkpiece(tipActual(g));
+    const double r = tipRadius();
+    const bool ball = tool_ == m_.probe.tool;
+    const double reach = ball ? 0.5 * r : std::max(0.0, r - 0.2);
+    const double bottom = ball ? w.z() - 0.866 * r : w.z();
+    return stock_.topUnder(w.head<2>(), reach) > bottom + 1e-6;
+  }
+
+  void checkWorkpiecePath(const MachinePosition& to, const std::string& what) const {
+    const Vector3d a = pos_.xyz_mm, b = to.xyz_mm;
+    const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / 0.5)));
+    for (int k = 0; k <= n; ++k) {
+      const Vector3d g = a + (b - a) * (static_cast<double>(k) / n);
+      const Vector3d tip = tipActual(g);
+      if (tip.z() - (tool_ == m_.probe.tool ? tipRadius() : 0.0) < m_.table_surface_z_mm - 1e-9)
+        throw SafetyError(what + " would hit the table at tip Z " + formatNumber(tip.z(), 4) + " mm");
+      if (inMaterial(g)) {
+        const Vector3d w = toWorkpiece(tip);
+        throw SafetyError(what + " would move through the workpiece's material at X " + formatNumber(w.x(), 3) +
+                          " Y " + formatNumber(w.y(), 3) + " Z " + formatNumber(w.z(), 3) + " (workpiece frame)");
+      }
+    }
+    if (to.c_deg != pos_.c_deg) {
+      const Vector3d w = toWorkpiece(tipActual(pos_.xyz_mm));
+      if (w.z() - tipRadius() < stock_.max().z() + 1e-9)
+        throw SafetyError(what + " turns the table with the tool below the top of the stock");
+    }
+  }
+
+  // Seed 000 Eq. 3.16 with I1 = I2 = I (the printed E*I^2 is read as E*I, notes §4.8):
+  // deflection per newton of a cantilevered end mill, mm/N.
+  static double toolCompliance(const parts::CuttingTool& t) {
+    const double L1 = t.flute_length_mm, L2 = t.stickout_mm, E = t.youngs_modulus_N_per_mm2;
+    const double I = kPi * std::pow(t.diameter_mm, 4) / 64.0;
+    return (L1 * L1 * L1 / 3.0 + L1 * (L2 - L1) * (L2 + L1) / 6.0 + L2 * (L2 - L1) * (2 * L2 + L1) / 6.0) / (E * I);
+  }
+
+  // A cutting feed move: material removed along the real tool path; the mean cutting force
+  // from the removal rate (P = k_c Q, F_t = P / v_c); the radial force K_r F_t pushes the
+  // tool away from the material, which bends (Eq. 3.16) and the structure yields (F/k); the
+  // surface cut is the swept volume of the displaced path.
+  void cutMove(const MachinePosition& to, double F) {
+    const parts::CuttingTool& t = *cutter();
+    const double r = t.diameter_mm / 2;
+    if (to.c_deg != pos_.c_deg || to.b_deg != pos_.b_deg)
+      throw InputError("", 0, "cutting with a rotary axis moving is not modelled");
+    const Vector3d w0 = toWorkpiece(tipActual(pos_.xyz_mm)), w1 = toWorkpiece(tipActual(to.xyz_mm));
+    if (w0.z() < m_.table_surface_z_mm - 1e-9 || w1.z() < m_.table_surface_z_mm - 1e-9)
+      throw SafetyError("feed move (G1/G2/G3) would cut into the table");
+    const double len = (to.xyz_mm - pos_.xyz_mm).norm();
+    const double dt = len / F * 60.0;
+    const Removal rem = stock_.removeHeightField(w0, w1, r);
+    Vector3d defl = Vector3d::Zero();
+    double Ft = 0, Fn = 0;
+    if (rem.volume_mm3 > 0 && dt > 0) {
+      const double vc = kPi * t.diameter_mm * std::fabs(spindle_rpm_) / 60.0;  // mm/s
+      Ft = w_->material.specific_cutting_force_N_per_mm2 * (rem.volume_mm3 / dt) / vc;
+      // Lateral offset of the removed material from the path, in the workpiece frame.
+      const Eigen::Vector2d a = w0.head<2>(), ab = w1.head<2>() - a;
+      Eigen::Vector2d lateral = rem.centroid.head<2>() - a;
+      if (ab.norm() > 1e-12) {
+        const Eigen::Vector2d e = ab.normalized();
+        lateral -= lateral.dot(e) * e;
+      }
+      if (lateral.norm() > 0.05 * r) {
+        Fn = w_->material.radial_force_ratio * Ft;
+        const Vector3d away_w(-lateral.x() / lateral.norm(), -lateral.y() / lateral.norm(), 0);
+        const Vector3d away_m = workpieceDirToMachine(away_w);
+        double c = toolCompliance(t);
+        const auto& k = tr_.stiffness_N_per_um;
+        for (int i = 0; i < 2; ++i)
+          if (k(i) > 0) c += away_m(i) * away_m(i) * 1e-3 / k(i);
+        defl = away_w * (Fn * c);
+      }
+    }
+    // The cut is made warm; in the 20 °C frame the tool's radius shrinks with the part.
+    const double r_w = r / (1.0 + tr_.artifact.alpha_per_K * workpieceAbove20K());
+    stock_.recordCut(w0 + defl, w1 + defl, r_w, t_);
+    cuts_.push_back({{"time_s", t_}, {"tool", tool_},
+                     {"p0_mm", {w0.x() + defl.x(), w0.y() + defl.y(), w0.z()}},
+                     {"p1_mm", {w1.x() + defl.x(), w1.y() + defl.y(), w1.z()}},
+                     {"radius_mm", r_w}, {"removed_mm3", rem.volume_mm3}, {"Ft_N", Ft}, {"Fn_N", Fn},
+                     {"deflection_um", {defl.x() * 1e3, defl.y() * 1e3}},
+                     {"tool_drift_um", {toolDriftUm().x(), toolDriftUm().y(), toolDriftUm().z()}}});
+    advance(dt);
+    pos_ = to;
+  }
+
+  gcode::ProbeOutcome probeWorkpiece(const MachinePosition& to, double F, const Vector3d& dir, double len) {
+    gcode::ProbeOutcome out;
+    double s_contact = -1;
+    if (w_) {
+      const double r = tipRadius();
+      const Vector3d a = toWorkpiece(tipActual(pos_.xyz_mm)), b = toWorkpiece(tipActual(to.xyz_mm));
+      const Vector3d d = (b - a).normalized();
+      // The ball touches a surface square to the approach when its centre is r from it.
+      if (const auto s = stock_.firstMaterial(a, d, (b - a).norm() + r)) s_contact = std::max(0.0, *s - r);
+      if (s_contact > (b - a).norm()) s_contact = -1;
+      // Nothing else in the way before the contact (height field).
+      MachinePosition until = to;
+      if (s_contact >= 0) until.xyz_mm = pos_.xyz_mm + dir * std::max(0.0, s_contact - 0.01);
+      checkWorkpiecePath(until, "probe move");
+    }
+    const double pre_um = pretravel(dir);
+    const double s_trig = s_contact >= 0 ? s_contact + pre_um * 1e-3 + F / 60.0 * tr_.probe.trigger_delay_s : 2 * len;
+    if (s_contact < 0 || s_trig > len) {
+      advance(len / F * 60.0);
+      pos_ = to;
+      out.stop = to;
+      return out;
+    }
+    ProbeEvent ev;
+    ev.c_deg = pos_.c_deg;
+    ev.approach = dir;
+    ev.pretravel_um = pre_um;
+    ev.location = locationErrors();
+    ev.tool_um = toolDriftUm();
+    ev.atc_um = atc_um_;
+    ev.artifact_dT_K = nodeRise(tr_.artifact.node);
+    ev.apparent = ev.location;
+    ev.noise_um = tr_.probe.noise_um > 0 ? tr_.probe.noise_um * normal_(noise_rng_) : 0.0;
+    Vector3d latched = pos_.xyz_mm + s_trig * dir + ev.noise_um * 1e-3 * dir;
+    if (tr_.probe.quantise) {
+      const double q[3] = {m_.x.resolution_mm, m_.y.resolution_mm, m_.z.resolution_mm};
+      for (int k = 0; k < 3; ++k) latched(k) = std::round(latched(k) / q[k]) * q[k];
+    }
+    advance(s_trig / F * 60.0);
+    ev.time_s = t_;
+    ev.reported_tip_mm = latched - Vector3d(0, 0, currentToolLength());
+    events_.push_back(ev);
+    pending_ = static_cast<long>(events_.size()) - 1;
+    pos_.xyz_mm = latched;
+    out.contact = true;
+    out.stop = pos_;
+    return out;
+  }
+
+ public:
+  const Stock& stock() const { return stock_; }
+  std::string cutsJson() const { return cuts_.dump(1) + "\n"; }
+
+ private:
   void fillTruth(ProbeEvent& ev, const Artifact& art) const {
     ev.location = art.location;
     ev.tool_um = toolDriftUm();
@@ -498,16 +690,20 @@ class VirtualMachine : public gcode::MachineInterface {
     ev.apparent[2] -= ev.tool_um.z();
     // The ball grows too; the known-radius fit reads that as a lift of the centre by the
     // radius change, because only the top point sees Z (docs/simulator.md).
-    ev.apparent[2] += a * (a_.centreHeightAboveTable() + a_.sphereRadius()) * 1e3;
-    ev.apparent[3] += a * a_.radius_from_axis_mm * 1e3;
+    ev.apparent[2] += a * (a_->centreHeightAboveTable() + a_->sphereRadius()) * 1e3;
+    ev.apparent[3] += a * a_->radius_from_axis_mm * 1e3;
   }
 };
 
 }  // namespace
 
 SimulationOutputs simulateProgram(const std::string& program_file, const std::string& text,
-                                  const parts::Machine& machine, const parts::SphereArtifact& part,
+                                  const parts::Machine& machine, const SimulationPart& part,
                                   const MachineTruth& truth, std::uint64_t seed) {
+  if ((part.artifact != nullptr) == (part.workpiece != nullptr))
+    throw InputError("", 0, "simulate needs exactly one part on the table: a sphere artifact or a workpiece");
+  if (!part.cmm_points.empty() && !part.workpiece)
+    throw InputError("", 0, "CMM points need a workpiece (kind: workpiece) as the part");
   const std::string ext = std::filesystem::path(program_file).extension().string();
   gcode::ProgramDialect dialect = machine.dialect == parts::Dialect::LinuxCnc ? gcode::ProgramDialect::LinuxCnc
                                                                               : gcode::ProgramDialect::FanucMacroB;
@@ -522,6 +718,12 @@ SimulationOutputs simulateProgram(const std::string& program_file, const std::st
   out.blocks = run.blocks_executed;
   out.end_time_s = vm.time();
   out.log_text = vm.logText();
+  if (part.workpiece) {
+    out.cuts_json = vm.cutsJson();
+    if (!part.cmm_points.empty())
+      out.cmm_csv = measureOnCmm(vm.stock(), *part.workpiece, part.cmm_points, "cmm points", seed);
+  }
+
   out.log_name = vm.logName().empty() || dialect == gcode::ProgramDialect::FanucMacroB ? "dprnt.txt" : vm.logName();
   out.inputs_csv = vm.inputsText();
   const auto& events = vm.events();
@@ -531,9 +733,17 @@ SimulationOutputs simulateProgram(const std::string& program_file, const std::st
   std::map<long, const ProbeEvent*> by_line;
   for (const auto& e : events)
     if (e.log_line > 0) by_line[e.log_line] = &e;
-  const auto logged = gcode::parseProbeLog(out.log_text, out.log_name);
+  // The points CSV needs the planner's log convention ("PT cycle position point x y z").
+  std::vector<gcode::LoggedProbePoint> logged;
+  bool pt_log = true;
+  try {
+    logged = gcode::parseProbeLog(out.log_text, out.log_name);
+  } catch (const InputError&) {
+    pt_log = false;
+  }
   std::ostringstream csv;
   csv << "# probeloop simulate " << program_file << ", seed " << seed << "\n";
+  if (!pt_log) csv << "# the log does not follow the planner's PT convention: no points\n";
   csv << "time_s,cycle,c_deg,feature,point,x_mm,y_mm,z_mm,nx,ny,nz\n";
   nlohmann::ordered_json jt;
   jt["format"] = "probeloop-truth";

@@ -3,7 +3,7 @@
 // and writes what the controller would: its log, plus the canonical points CSV, the
 // inputs CSV and the truth behind every probe event.
 //
-// Physics (docs/simulator.md):
+// Physics (docs/simulator.md; machining and the CMM stage in §2.4):
 // - clock: rapids per axis at the rapid feed (C and B at their maximum speed), feeds along
 //   the XYZ path, dwells, tool changes at the machine's tool-change time; no acceleration;
 // - the stylus tip (sphere of radius r_tip) = gauge line - tool length + tool-side errors
@@ -24,6 +24,8 @@
 #include "gcode/interpreter.hpp"
 #include "parts/machine.hpp"
 #include "parts/sphere_artifact.hpp"
+#include "parts/workpiece.hpp"
+#include "sim/cmm_stage.hpp"
 #include "sim/machine_truth.hpp"
 
 namespace probeloop::sim {
@@ -34,13 +36,30 @@ struct SimulationOutputs {
   std::string points_csv;  // canonical points CSV (docs/formats.md)
   std::string inputs_csv;  // temperatures and machine state over time
   std::string truth_json;  // injected error values per probe event and per cycle
+  std::string cuts_json;   // workpiece: the surfaces actually cut (swept volumes), forces
+  std::string cmm_csv;     // workpiece with CMM points: the CMM export
   double end_time_s = 0;
   long probe_events = 0;
   long blocks = 0;
 };
 
+// What stands on the table: a sphere artifact or a workpiece (exactly one).
+struct SimulationPart {
+  const parts::SphereArtifact* artifact = nullptr;
+  const parts::Workpiece* workpiece = nullptr;
+  std::vector<CmmPoint> cmm_points;  // workpiece: measured on the CMM after the program
+};
+
 SimulationOutputs simulateProgram(const std::string& program_file, const std::string& program_text,
-                                  const parts::Machine& machine, const parts::SphereArtifact& part,
+                                  const parts::Machine& machine, const SimulationPart& part,
                                   const MachineTruth& truth, std::uint64_t seed);
+
+inline SimulationOutputs simulateProgram(const std::string& program_file, const std::string& program_text,
+                                         const parts::Machine& machine, const parts::SphereArtifact& artifact,
+                                         const MachineTruth& truth, std::uint64_t seed) {
+  SimulationPart part;
+  part.artifact = &artifact;
+  return simulateProgram(program_file, program_text, machine, part, truth, seed);
+}
 
 }  // namespace probeloop::sim

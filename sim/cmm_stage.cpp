@@ -1,0 +1,61 @@
+#include "sim/cmm_stage.hpp"
+
+#include <cmath>
+#include <random>
+#include <sstream>
+
+#include "core/atomic_file.hpp"
+#include "core/csv.hpp"
+#include "core/error.hpp"
+#include "sim/material_removal.hpp"
+
+namespace probeloop::sim {
+
+std::vector<CmmPoint> readCmmPoints(const std::string& path) {
+  const CsvTable t = parseCsv(readFile(path), path);
+  const char* need[] = {"feature", "point", "x_mm", "y_mm", "z_mm", "nx", "ny", "nz"};
+  for (const char* n : need)
+    if (t.column(n) < 0)
+      throw InputError(path, t.header_line, std::string("CMM points need the column '") + n +
+                                                "' (feature,point,x_mm,y_mm,z_mm,nx,ny,nz)");
+  std::vector<CmmPoint> out;
+  for (const auto& r : t.rows) {
+    CmmPoint p;
+    p.line = r.line;
+    p.feature = r.fields[static_cast<std::size_t>(t.column("feature"))];
+    p.point = static_cast<int>(t.number(r, t.column("point")));
+    p.nominal_mm = Eigen::Vector3d(t.number(r, t.column("x_mm")), t.number(r, t.column("y_mm")), t.number(r, t.column("z_mm")));
+    p.normal = Eigen::Vector3d(t.number(r, t.column("nx")), t.number(r, t.column("ny")), t.number(r, t.column("nz")));
+    if (std::fabs(p.normal.norm() - 1.0) > 1e-6)
+      throw InputError(path, r.line, "nx,ny,nz must be a unit vector (length " + formatNumber(p.normal.norm()) + ")");
+    out.push_back(p);
+  }
+  if (out.empty()) throw InputError(path, 0, "no CMM points");
+  return out;
+}
+
+std::string measureOnCmm(const Stock& stock, const parts::Workpiece& w, const std::vector<CmmPoint>& points,
+                         const std::string& file, std::uint64_t seed, double search) {
+  std::mt19937_64 rng(seed ^ 0xC3A5C85C97CB3127ULL);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::ostringstream o;
+  o << "# probeloop simulate: CMM export, workpiece frame at 20 C; MPE = " << formatNumber(w.cmm.mpe_constant_um)
+    << " um" << (w.cmm.mpe_length_mm > 0 ? " + L/" + formatNumber(w.cmm.mpe_length_mm) : std::string()) << "\n";
+  o << "feature,point,x_mm,y_mm,z_mm,nx,ny,nz\n";
+  for (const auto& p : points) {
+    const Eigen::Vector3d from = p.nominal_mm + search * p.normal;
+    const auto s = stock.firstMaterial(from, -p.normal, 2 * search);
+    if (!s)
+      throw InputError(file, p.line, "CMM point " + p.feature + " " + std::to_string(p.point) +
+                                         ": no surface within " + formatNumber(search) + " mm of the nominal point along the normal");
+    const double L = (p.nominal_mm - w.datum()).norm();
+    const double mpe_um = w.cmm.mpe_constant_um + (w.cmm.mpe_length_mm > 0 ? L / w.cmm.mpe_length_mm : 0.0);
+    const Eigen::Vector3d m = from - *s * p.normal + (mpe_um / 2) * 1e-3 * normal(rng) * p.normal;
+    o << p.feature << "," << p.point << "," << formatNumber(m.x(), 4) << "," << formatNumber(m.y(), 4) << ","
+      << formatNumber(m.z(), 4) << "," << formatNumber(p.normal.x(), 6) << "," << formatNumber(p.normal.y(), 6) << ","
+      << formatNumber(p.normal.z(), 6) << "\n";
+  }
+  return o.str();
+}
+
+}  // namespace probeloop::sim

@@ -1,0 +1,35 @@
+// The CMM that inspects a machined workpiece: planned points (nominal surface point and
+// outward normal, workpiece frame at 20 °C) are probed along the normal against the surface
+// the machine actually cut (sim::Stock's exact surface) with the CMM's own noise.
+//
+// Contract: readCmmPoints needs the columns feature,point,x_mm,y_mm,z_mm,nx,ny,nz (normal
+// unit length within 1e-6, else InputError with file:line). measureOnCmm throws InputError
+// naming the point when no surface lies within ±search_mm of the nominal point. Noise:
+// normal along the normal with sigma = MPE(L)/2, MPE = A + L/K, L the point's distance from
+// the workpiece datum (a length-dependent per-point model); reported to 0.1 um.
+#pragma once
+#include <Eigen/Dense>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "parts/workpiece.hpp"
+
+namespace probeloop::sim {
+
+class Stock;
+
+struct CmmPoint {
+  std::string feature;
+  int point = 0;
+  int line = 0;
+  Eigen::Vector3d nominal_mm = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // outward, away from the material
+};
+
+std::vector<CmmPoint> readCmmPoints(const std::string& path);
+
+std::string measureOnCmm(const Stock& stock, const parts::Workpiece& w, const std::vector<CmmPoint>& points,
+                         const std::string& points_file, std::uint64_t seed, double search_mm = 5.0);
+
+}  // namespace probeloop::sim

@@ -1,0 +1,223 @@
+// Machining on the virtual machine and the CMM stage: a block is faced and side-milled by a
+// hand-written LinuxCNC program, then measured on the CMM; every expectation is derived here
+// from the effect's definition (translation, Eq. 3.16 + F/k, alpha dT L), not read back.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <unistd.h>
+
+#include "core/csv.hpp"
+#include "core/error.hpp"
+#include "sim/material_removal.hpp"
+#include "sim/virtual_machine.hpp"
+
+namespace probeloop::sim {
+namespace {
+
+namespace fs = std::filesystem;
+using Eigen::Vector3d;
+
+std::string src(const std::string& rel) { return std::string(PROBELOOP_SOURCE_DIR) + "/" + rel; }
+
+std::string writeTemp(const std::string& name, const std::string& text) {
+  static std::atomic<int> n{0};
+  const fs::path d = fs::temp_directory_path() / ("probeloop-mach-" + std::to_string(::getpid()) + "-" + std::to_string(n++));
+  fs::create_directories(d);
+  std::ofstream(d / name) << text;
+  return (d / name).string();
+}
+
+MachineTruth truthFrom(const std::string& yaml) {
+  return loadMachineTruth(writeTemp("truth.yaml", "kind: machine_truth\n" + yaml));
+}
+
+// Face the top to z 38 (passes along X, 8 mm stepover), then side-mill the +X wall to x 35
+// down to z 30 along +Y; all in tip (program) coordinates on the LinuxCNC mill.
+const std::string kProgram = R"(G21 G90 G17 G94
+G10 L2 P6 X0 Y0 Z0 C0
+G59
+T1 M6
+G43 H1
+S8000 M3
+G0 X-50 Y-34 Z60
+G0 Z38
+G1 X50 F800
+G1 Y-26
+G1 X-50
+G1 Y-18
+G1 X50
+G1 Y-10
+G1 X-50
+G1 Y-2
+G1 X50
+G1 Y6
+G1 X-50
+G1 Y14
+G1 X50
+G1 Y22
+G1 X-50
+G1 Y30
+G1 X50
+G1 Y38
+G0 Z60
+G0 X40 Y-40
+G0 Z30
+G1 Y-30 F600
+G1 Y30
+G1 Y40
+G0 Z60
+M5
+M2
+)";
+
+struct Result {
+  SimulationOutputs out;
+  std::vector<Vector3d> cmm;
+  nlohmann::json cuts;
+};
+
+std::vector<CmmPoint> plannedPoints() {
+  std::vector<CmmPoint> pts;
+  int k = 0;
+  for (double x : {-30.0, 0.0, 25.0})
+    for (double y : {-20.0, 0.0, 20.0}) pts.push_back({"TOP", ++k, 0, Vector3d(x, y, 38), Vector3d(0, 0, 1)});
+  k = 0;
+  for (double y : {-20.0, 0.0, 20.0})
+    for (double z : {32.0, 36.0}) pts.push_back({"WALL", ++k, 0, Vector3d(35, y, z), Vector3d(1, 0, 0)});
+  return pts;
+}
+
+// The CMM export has 4 decimals (0.1 um): every comparison with it allows half of that.
+constexpr double kCmmDigit = 0.5e-4 + 1e-12;
+
+Result machine(const MachineTruth& truth, parts::Workpiece w, const std::string& program = kProgram,
+               std::vector<CmmPoint> pts = plannedPoints()) {
+  const auto m = parts::loadMachine(src("parts/machines/linuxcnc_rotary_mill.yaml"));
+  SimulationPart part;
+  part.workpiece = &w;
+  part.cmm_points = std::move(pts);
+  Result r;
+  r.out = simulateProgram("mill.ngc", program, m, part, truth, 1);
+  if (r.out.cmm_csv.empty()) {
+    r.cuts = nlohmann::json::parse(r.out.cuts_json);
+    return r;
+  }
+  const CsvTable t = parseCsv(r.out.cmm_csv, "cmm");
+  for (const auto& row : t.rows)
+    r.cmm.emplace_back(t.number(row, t.column("x_mm")), t.number(row, t.column("y_mm")), t.number(row, t.column("z_mm")));
+  r.cuts = nlohmann::json::parse(r.out.cuts_json);
+  return r;
+}
+
+parts::Workpiece block(double radial_ratio, double mpe_um = 0) {
+  auto w = parts::loadWorkpiece(src("examples/workpiece_block.yaml"));
+  w.material.radial_force_ratio = radial_ratio;
+  w.cmm.mpe_constant_um = mpe_um;
+  w.cmm.mpe_length_mm = 0;
+  return w;
+}
+
+TEST(Machining, WithoutErrorsTheCutSurfacesAreNominal) {
+  const auto r = machine(truthFrom(""), block(0.0));
+  ASSERT_EQ(r.cmm.size(), 15u);
+  const auto pts = plannedPoints();
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    EXPECT_LT((r.cmm[i] - pts[i].nominal_mm).cwiseAbs().maxCoeff(), kCmmDigit) << pts[i].feature << " " << pts[i].point;
+}
+
+// The table 5 um up (EZ0T) and the tool tip 3 um up (tool_Z): the tool cuts 5 - 3 = 2 um
+// deeper into the workpiece, and the CMM finds the faced top at 38 - 0.002 mm.
+TEST(Machining, TranslationsOfTableAndToolMoveTheFloor) {
+  const auto r = machine(truthFrom("static: {EZ0T_um: 5, tool_Z_um: 3, EX0C_um: 4}\n"), block(0.0));
+  for (int i = 0; i < 9; ++i) EXPECT_NEAR(r.cmm[i].z(), 38 - 0.002, kCmmDigit);
+  // EX0C: the table 4 um to +X -> the tool path sits 4 um further -X on the workpiece.
+  for (int i = 9; i < 15; ++i) EXPECT_NEAR(r.cmm[i].x(), 35 - 0.004, kCmmDigit);
+}
+
+// Side milling pushes the tool away from the material (+X here): the wall stays proud by
+// F_n (C_tool + 1/k_x), C_tool from seed 000 Eq. 3.16 with I = pi d^4 / 64 (derived here).
+TEST(Machining, ForceDeflectionLeavesTheWallProud) {
+  const auto w = block(0.4);
+  const auto r = machine(truthFrom("structure: {stiffness_x_N_per_um: 20, stiffness_y_N_per_um: 20}\n"), w);
+  const auto& t = w.tools[0];
+  const double L1 = 25, L2 = 40, E = 600e3, I = M_PI * std::pow(10.0, 4) / 64;
+  ASSERT_DOUBLE_EQ(t.flute_length_mm, L1);
+  const double c_tool = (std::pow(L1, 3) / 3 + L1 * (L2 - L1) * (L2 + L1) / 6 + L2 * (L2 - L1) * (2 * L2 + L1) / 6) / (E * I);
+  EXPECT_NEAR(c_tool, 6.7131e-5, 1e-8);  // mm/N, by hand: 19770.8 / (600e3 * 490.874)
+  // The full-engagement move (Y -30 -> 30 at X 40): ae = 5 mm, ap = 8 mm (38 after facing
+  // down to 30), vf = 10 mm/s for 6 s; the quarter disk (pi 25 / 4 mm^2) at Y -30 went with
+  // the entry move. Mean tangential force = k_c x removal rate / cutting speed.
+  const nlohmann::json* full = nullptr;
+  for (const auto& c : r.cuts)
+    if (std::fabs(c["p0_mm"][1].get<double>() + 30) < 1e-6 && std::fabs(c["p1_mm"][1].get<double>() - 30) < 1e-6) full = &c;
+  ASSERT_NE(full, nullptr);
+  const double vc = M_PI * 10 * 8000 / 60.0;                    // mm/s
+  const double removed = (5 * 60 - M_PI * 25 / 4) * 8;            // mm^3
+  const double Ft_textbook = 700.0 * (removed / 6.0) / vc;        // = 62.5 N
+  const double Ft = (*full)["Ft_N"], Fn = (*full)["Fn_N"];
+  EXPECT_NEAR(Ft, Ft_textbook, 0.01 * Ft_textbook);  // height field of 0.25 mm cells
+  EXPECT_NEAR(Fn, 0.4 * Ft, 1e-9);
+  const double defl_mm = Fn * (c_tool + 1e-3 / 20.0);
+  EXPECT_NEAR((*full)["deflection_um"][0].get<double>(), defl_mm * 1e3, 1e-9);
+  EXPECT_GT(defl_mm, 0.002);  // a few micrometres: visible on a CMM
+  for (int i = 9; i < 15; ++i) EXPECT_NEAR(r.cmm[i].x(), 35 + defl_mm, kCmmDigit) << i;
+  // Facing along X removes material on both sides of the path in the first pass only.
+  EXPECT_NEAR(r.cmm[4].z(), 38, kCmmDigit);
+}
+
+// Cut warm, measured at 20 °C: the workpiece shrinks about its datum (bottom centre).
+TEST(Machining, AWarmWorkpieceShrinksOnTheCmm) {
+  const auto r = machine(truthFrom(R"(
+thermal:
+  environment: {mean_C: 26}
+  nodes: [{name: part, capacity_J_per_K: 100, to_environment_W_per_K: 50}]
+artifact: {node: part, alpha_um_per_m_K: 23.4}
+)"), block(0.0));
+  const double s = 1.0 / (1.0 + 23.4e-6 * 6.0);
+  const auto pts = plannedPoints();
+  for (int i = 0; i < 9; ++i) EXPECT_NEAR(r.cmm[i].z(), 38 * s, kCmmDigit);
+  for (int i = 9; i < 15; ++i) EXPECT_NEAR(r.cmm[i].x(), 35 * s, kCmmDigit);
+}
+
+TEST(Machining, CmmNoiseFollowsItsMpe) {
+  std::vector<CmmPoint> pts;
+  for (int k = 0; k < 400; ++k) pts.push_back({"TOP", k + 1, 0, Vector3d(-30 + (k % 20) * 2.5, -20 + (k / 20) * 2.0, 38), Vector3d(0, 0, 1)});
+  const auto r = machine(truthFrom(""), block(0.0, 1.2), kProgram, pts);
+  double ss = 0;
+  for (const auto& p : r.cmm) ss += (p.z() - 38) * (p.z() - 38);
+  const double sigma_um = std::sqrt(ss / r.cmm.size()) * 1e3;
+  EXPECT_NEAR(sigma_um, 0.6, 0.6 * 0.15);  // MPE / 2; 400 draws: +-7 % (1 sigma)
+}
+
+TEST(Machining, TheProbeFindsTheCutFloor) {
+  const std::string prog = kProgram.substr(0, kProgram.find("M5\n")) +
+                           "M5\nT99 M6\nG43 H99\nG0 X0 Y0 Z50\nG38.2 Z30 F100\n(LOGOPEN,p.log)\n(LOG,#5063)\nM2\n";
+  const auto r = machine(truthFrom(""), block(0.0), prog, {});
+  // Tip centre at contact: the floor 38 + tip radius 3.
+  EXPECT_EQ(r.out.log_text, "41.000000\n");
+}
+
+void expectRefusal(const std::string& prog, const std::string& want) {
+  try {
+    machine(truthFrom(""), block(0.0), prog, {});
+    FAIL() << "accepted; expected " << want;
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
+  }
+}
+
+TEST(Machining, UnsafeMovesNameTheirLine) {
+  const std::string head = "G21 G90\nT1 M6\nG43 H1\n";
+  expectRefusal(head + "G0 X0 Y0 Z60\nG0 Z30\n", "mill.ngc:5: rapid (G0) would move through the workpiece's material");
+  expectRefusal(head + "G0 X-60 Y0 Z30\nG1 X0 F500\n", "mill.ngc:5: feed move (G1/G2/G3) with the spindle stopped would move through");
+  expectRefusal(head + "S5000 M3\nG0 X-60 Y0 Z30\nG1 Z-1 F500\n", "mill.ngc:6: feed move (G1/G2/G3) would cut into the table");
+  expectRefusal(head + "S5000 M3\nT99 M6\n", "mill.ngc:5: tool change with the spindle turning");
+}
+
+}  // namespace
+}  // namespace probeloop::sim
