@@ -1,5 +1,10 @@
 #include "parts/machine.hpp"
 
+#include <algorithm>
+#include <cctype>
+#include <stdexcept>
+#include <vector>
+
 #include "core/error.hpp"
 #include "parts/yaml_reader.hpp"
 
@@ -44,6 +49,44 @@ RotaryAxis readRotary(YamlMap m, bool with_sense) {
 
 }  // namespace
 
+std::array<bool, 3> workpieceSideAxes(const std::string& code) {
+  std::array<bool, 3> side{false, false, false};
+  if (code.empty()) return side;
+  const auto open = code.find('['), close = code.rfind(']');
+  if (open == std::string::npos || close == std::string::npos || close < open)
+    throw std::invalid_argument("expected a code like \"V[w C' Y X Z t]\" (ISO 10791-1: axes from the workpiece w to the tool t)");
+  const std::string body = code.substr(open + 1, close - open - 1);
+  // Tokens: letters with optional digits and prime; brackets group gantry axes.
+  std::vector<std::string> tokens;
+  std::string cur;
+  for (char ch : body) {
+    if (std::isalnum(static_cast<unsigned char>(ch)) || ch == '\'') {
+      cur += ch;
+    } else {
+      if (!cur.empty()) tokens.push_back(cur);
+      cur.clear();
+    }
+  }
+  if (!cur.empty()) tokens.push_back(cur);
+  if (tokens.empty() || tokens.front() != "w" || tokens.back() != "t")
+    throw std::invalid_argument("the chain must run from the workpiece 'w' to the tool 't'");
+  const bool has_frame = std::find(tokens.begin(), tokens.end(), "b") != tokens.end();
+  bool before_frame = true;
+  for (const auto& t : tokens) {
+    if (t == "b") {
+      before_frame = false;
+      continue;
+    }
+    const int axis = t[0] == 'X' ? 0 : t[0] == 'Y' ? 1 : t[0] == 'Z' ? 2 : -1;
+    if (axis < 0) continue;
+    const bool primed = t.back() == '\'';
+    // With the frame b in the code, the axes before it carry the workpiece; without it,
+    // ISO 841's prime marks an axis that moves the workpiece.
+    side[static_cast<std::size_t>(axis)] = has_frame ? before_frame : primed;
+  }
+  return side;
+}
+
 Machine loadMachine(const std::string& path) {
   YamlMap root(loadYamlFile(path), path, "");
   Machine mc;
@@ -58,16 +101,28 @@ Machine loadMachine(const std::string& path) {
   mc.y = readLinear(axes.map("Y"));
   mc.z = readLinear(axes.map("Z"));
   if (auto b = axes.mapIfPresent("B")) mc.b = readRotary(*b, false);
-  mc.c = readRotary(axes.map("C"), true);
+  if (auto c = axes.mapIfPresent("C")) mc.c = readRotary(*c, true);
   axes.finish();
   mc.rapid_feed_mm_per_min = root.quantity("rapid_feed", Dimension::Feed);
   if (!(mc.rapid_feed_mm_per_min > 0)) root.fail("rapid_feed", "must be positive");
 
-  YamlMap table = root.map("c_axis");
-  mc.c_axis_centre_mm.x() = table.quantity("centre_x", Dimension::Length);
-  mc.c_axis_centre_mm.y() = table.quantity("centre_y", Dimension::Length);
-  mc.table_surface_z_mm = table.quantity("table_surface_z", Dimension::Length);
-  table.finish();
+  if (mc.c.present) {
+    YamlMap table = root.map("c_axis");
+    mc.c_axis_centre_mm.x() = table.quantity("centre_x", Dimension::Length);
+    mc.c_axis_centre_mm.y() = table.quantity("centre_y", Dimension::Length);
+    mc.table_surface_z_mm = table.quantity("table_surface_z", Dimension::Length);
+    table.finish();
+  } else {
+    // No rotary table: only the table surface.
+    YamlMap table = root.map("table");
+    mc.table_surface_z_mm = table.quantity("surface_z", Dimension::Length);
+    table.finish();
+  }
+  try {
+    mc.workpiece_side = workpieceSideAxes(mc.iso10791_code);
+  } catch (const std::invalid_argument& e) {
+    root.fail("iso10791_code", e.what());
+  }
 
   const std::string wo = root.choice("work_offset", {"G54", "G55", "G56", "G57", "G58", "G59"});
   mc.work_offset = wo[2] - '3';  // G54 -> 1 ... G59 -> 6

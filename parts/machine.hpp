@@ -5,6 +5,7 @@
 // the gauge line minus (0, 0, probe.length). Travel limits apply to the gauge line.
 #pragma once
 #include <Eigen/Dense>
+#include <array>
 #include <string>
 
 namespace probeloop::parts {
@@ -55,7 +56,13 @@ struct Machine {
   int work_offset = 6;                  // 1..6 = G54..G59; the program zeroes it
   ToolChangeSpec tool_change;
   ProbeSpec probe;
+  // X, Y, Z: does the axis move the workpiece (true) or the tool (false)? From the ISO
+  // 10791-1 code: axes between w and the frame b carry the workpiece; without b, a primed
+  // axis (X', ISO 841) does. Decides the Abbe lever of the axis's angular errors.
+  std::array<bool, 3> workpiece_side{false, false, false};
 };
+
+std::array<bool, 3> workpieceSideAxes(const std::string& iso10791_code);  // std::invalid_argument
 
 Machine loadMachine(const std::string& path);
 

@@ -117,6 +117,8 @@ SpherePlan planSphereCycle(const SphereArtifact& a, const Machine& m, const Plan
   const double R = a.sphereRadius();
   const double Rt = R + r_tip;  // stylus-tip centre distance from the sphere centre at contact
   const double sense = m.c.positive_is_clockwise ? -1.0 : 1.0;
+  if (!m.c.present)
+    throw InputError(m.file, 0, "axes.C: the sphere-artifact cycle needs a rotary table (C axis); this machine has none");
 
   if (a.stem_length_mm + R <= r_tip)
     throw SafetyError(a.file + ": sphere.stem_length: the stylus tip would touch the table when "

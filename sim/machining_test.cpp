@@ -96,8 +96,9 @@ std::vector<CmmPoint> plannedPoints() {
 constexpr double kCmmDigit = 0.5e-4 + 1e-12;
 
 Result machine(const MachineTruth& truth, parts::Workpiece w, const std::string& program = kProgram,
-               std::vector<CmmPoint> pts = plannedPoints()) {
-  const auto m = parts::loadMachine(src("parts/machines/linuxcnc_rotary_mill.yaml"));
+               std::vector<CmmPoint> pts = plannedPoints(),
+               const std::string& machine_file = "parts/machines/linuxcnc_rotary_mill.yaml") {
+  const auto m = parts::loadMachine(src(machine_file));
   SimulationPart part;
   part.workpiece = &w;
   part.cmm_points = std::move(pts);
@@ -200,6 +201,24 @@ TEST(Machining, TheProbeFindsTheCutFloor) {
   const auto r = machine(truthFrom(""), block(0.0), prog, {});
   // Tip centre at contact: the floor 38 + tip radius 3.
   EXPECT_EQ(r.out.log_text, "41.000000\n");
+}
+
+// The same pitch error EBX = 100 urad of the X axis, probing the stock's +X face 20 mm above
+// the table with the 150 mm probe. On the VMC X moves the table (V[w X' Y' b Z t]): the table
+// turns about its surface, lever +20 mm, the tip is displaced eps x (0,0,20): dx = +2 um. On
+// the mill X moves the tool (V[w C' Y X Z t]): lever gauge line -> tip (0,0,-150): dx = -15 um.
+// The tip meets the face (x 40) at tip centre 43, commanded 43 - dx.
+TEST(Machining, AngularErrorsActThroughTheAbbeLeverOfTheirSide) {
+  const std::string prog = "G21 G90\nT99 M6\nG43 H99\nG0 X50 Y0 Z60\nG0 Z20\nG38.2 X38 F100\n(LOGOPEN,p.log)\n(LOG,#5061)\nM2\n";
+  const auto truth = truthFrom("axes: {X: {EBX_urad: [100]}}\n");
+  const auto vmc = machine(truth, block(0.0), prog, {}, "parts/machines/vmc3.yaml");
+  EXPECT_EQ(vmc.out.log_text, "42.998000\n");
+  const auto mill = machine(truth, block(0.0), prog, {});
+  EXPECT_EQ(mill.out.log_text, "43.015000\n");
+  EXPECT_EQ(parts::workpieceSideAxes("V[w X' Y' b Z t]"), (std::array<bool, 3>{true, true, false}));
+  EXPECT_EQ(parts::workpieceSideAxes("V[w C2' B' b [Y1 Y2] X [Z1 Z2] (C1) t]"), (std::array<bool, 3>{false, false, false}));
+  EXPECT_EQ(parts::workpieceSideAxes("V[w Y' C' X Z t]"), (std::array<bool, 3>{false, true, false}));
+  EXPECT_THROW(parts::workpieceSideAxes("w X Y Z t"), std::invalid_argument);
 }
 
 void expectRefusal(const std::string& prog, const std::string& want) {

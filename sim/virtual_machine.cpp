@@ -383,13 +383,17 @@ class VirtualMachine : public gcode::MachineInterface {
   Vector3d toolError(const Vector3d& g) const {
     Vector3d d = toolDriftUm() * 1e-3;
     if (tr_.axes.any) {
-      const Vector3d lever(0, 0, -currentToolLength());  // gauge line -> tip
+      // Abbe levers: a tool-side axis's angular error turns the tool about the gauge line
+      // (lever gauge line -> tip); a workpiece-side axis's turns the table about its surface
+      // under the tip (lever table -> tip). Errors are tool-relative-to-workpiece (ISO 230-1).
+      const double tip_z = g.z() - currentToolLength();
+      const Vector3d tool_lever(0, 0, -currentToolLength()), table_lever(0, 0, tip_z - m_.table_surface_z_mm);
       for (int ax = 0; ax < 3; ++ax) {
         const auto& c = tr_.axes.coeff[ax];
         const double p = g(ax);
         Vector3d trans(poly(c[0], p), poly(c[1], p), poly(c[2], p));
         Vector3d rot(poly(c[3], p), poly(c[4], p), poly(c[5], p));
-        d += trans * 1e-3 + (rot * 1e-6).cross(lever);
+        d += trans * 1e-3 + (rot * 1e-6).cross(m_.workpiece_side[ax] ? table_lever : tool_lever);
       }
     }
     // Squareness as right-hand rotations of the Y and Z axes (docs/simulator.md).
@@ -700,6 +704,8 @@ class VirtualMachine : public gcode::MachineInterface {
 SimulationOutputs simulateProgram(const std::string& program_file, const std::string& text,
                                   const parts::Machine& machine, const SimulationPart& part,
                                   const MachineTruth& truth, std::uint64_t seed) {
+  if (part.artifact && !machine.c.present)
+    throw InputError(machine.file, 0, "the sphere artifact stands on a rotary table, and this machine has no C axis");
   if ((part.artifact != nullptr) == (part.workpiece != nullptr))
     throw InputError("", 0, "simulate needs exactly one part on the table: a sphere artifact or a workpiece");
   if (!part.cmm_points.empty() && !part.workpiece)
