@@ -30,5 +30,12 @@ echo
 echo "== 4. compare with the injected truth (truth.json: what the simulator put in) =="
 python3 tests/integration/compare_errors.py "$OUT/eval/errors.csv" "$OUT/run/truth.json" 0 0 --coverage
 echo
+echo "== 5. machining on the virtual VMC: face and side-mill a block, then the CMM (examples/truth_machining.yaml) =="
+$PL simulate examples/block_face_and_wall.ngc --machine parts/machines/vmc3.yaml --part examples/workpiece_block.yaml \
+  --truth examples/truth_machining.yaml --cmm-points examples/block_cmm_points.csv --out "$OUT/machining"
+$PL fit plane "$OUT/machining/cmm_export.csv" --feature TOP | sed -n '1p;4p;9p'
+$PL fit plane "$OUT/machining/cmm_export.csv" --feature WALL_X | sed -n '1,2p;9p'
+echo "   (the top is faced deep by the spindle's growth; the wall stands proud by the tool's deflection: cuts.json)"
+echo
 echo "Outputs: $OUT/plan (G-code, manifest), $OUT/run (controller log, points.csv, inputs.csv, truth.json),"
-echo "         $OUT/eval (errors.csv, evaluation.json, campaign.gltf)"
+echo "         $OUT/eval (errors.csv, evaluation.json, campaign.gltf), $OUT/machining (cuts.json, cmm_export.csv)"

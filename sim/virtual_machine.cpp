@@ -730,7 +730,8 @@ SimulationOutputs simulateProgram(const std::string& program_file, const std::st
       out.cmm_csv = measureOnCmm(vm.stock(), *part.workpiece, part.cmm_points, "cmm points", seed);
   }
 
-  out.log_name = vm.logName().empty() || dialect == gcode::ProgramDialect::FanucMacroB ? "dprnt.txt" : vm.logName();
+  if (dialect == gcode::ProgramDialect::FanucMacroB) out.log_name = "dprnt.txt";
+  else out.log_name = vm.logName().empty() ? "controller.log" : vm.logName();
   out.inputs_csv = vm.inputsText();
   const auto& events = vm.events();
   out.probe_events = static_cast<long>(events.size());

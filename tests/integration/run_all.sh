@@ -151,6 +151,36 @@ sed 's/radius_from_c_axis: 160 mm/radius_from_c_axis: 150 mm/' "$ART" > "$W/move
 refuses "artifact not where the program expects: the program's own alarm" "#3000=2 \(UNEXPECTED CONTACT\)" "$PL" simulate "$FA_PLAN/sphere_cycle.nc" --machine "$NMV" --part "$W/moved.yaml" --truth "$CAMP" --out "$W/sx"
 check "nothing written by refused simulations" test ! -e "$W/sx"
 
+# --- machining on the virtual VMC, then the CMM ---------------------------------------------
+VMC=$SRC/parts/machines/vmc3.yaml
+check "simulate machines the block and measures it on the CMM" "$PL" simulate "$SRC/examples/block_face_and_wall.ngc" --machine "$VMC" \
+  --part "$SRC/examples/workpiece_block.yaml" --truth "$SRC/examples/truth_machining.yaml" --cmm-points "$SRC/examples/block_cmm_points.csv" --out "$W/m"
+check "machining writes the cut surfaces and the CMM export" test -s "$W/m/cuts.json" -a -s "$W/m/cmm_export.csv"
+"$PL" fit plane "$W/m/cmm_export.csv" --feature TOP --json > "$W/m/top.json"
+"$PL" fit plane "$W/m/cmm_export.csv" --feature WALL_X --json > "$W/m/wall.json"
+# The faced top sits below 38 by the spindle's growth (a few um) and is flat to the CMM's
+# noise; the wall stands proud of 35 by the tool's deflection. Bounds: 38 - 0.02 .. 38,
+# form < 4 MPE; 35 .. 35.02.
+check "CMM top face: faced a few um deep, flat within the CMM's noise" python3 - "$W/m/top.json" "$W/m/wall.json" <<'PY'
+import json, sys
+top, wall = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+def param(fit, name):
+    for p in fit["parameters"]:
+        if p["name"] == name:
+            return p["value"]
+    raise KeyError(name)
+z, x = param(top, "z_mm"), param(wall, "x_mm")
+assert 37.98 < z < 38.0, z
+assert 35.0 < x < 35.02, x
+print("top z", z, "wall x", x)
+PY
+sed 's/^G1 Y-30 F600/G0 Y-30/' "$SRC/examples/block_face_and_wall.ngc" > "$W/rapidcut.ngc"
+line=$(grep -n '^G0 Y-30' "$W/rapidcut.ngc" | cut -d: -f1)
+refuses "a rapid through the stock names its line" "rapidcut.ngc:$line: rapid \(G0\) would move through the workpiece's material" \
+  "$PL" simulate "$W/rapidcut.ngc" --machine "$VMC" --part "$SRC/examples/workpiece_block.yaml" --truth "$SRC/examples/truth_machining.yaml" --out "$W/mx"
+refuses "the sphere cycle needs a C axis" "needs a rotary table" "$PL" plan "$ART" --machine "$VMC" --out "$W/mx"
+check "nothing written by refused machining" test ! -e "$W/mx"
+
 # --- bad input: clear message, non-zero exit, nothing half-written ------------------------
 sed 's/  approach: 3 mm/  approach: 3 mm\n  aproach: 3 mm/' "$ART" | sed 's/\\n/\n/' > "$W/unknown.yaml"
 refuses "unknown YAML key names file:line" "unknown.yaml:19: unknown key 'probing.aproach'" "$PL" plan "$W/unknown.yaml" --machine "$NMV" --out "$W/x"
