@@ -41,21 +41,7 @@ double EnvironmentProfile::at(double t) const {
   return T;
 }
 
-geometry::LocationErrors MachineTruth::keyframeAt(double t) const {
-  if (keyframes.empty()) return {};
-  if (t <= keyframes.front().time_s) return keyframes.front().errors;
-  if (t >= keyframes.back().time_s) return keyframes.back().errors;
-  for (std::size_t i = 1; i < keyframes.size(); ++i) {
-    if (t <= keyframes[i].time_s) {
-      const auto va = keyframes[i - 1].errors.values(), vb = keyframes[i].errors.values();
-      const double w = (t - keyframes[i - 1].time_s) / (keyframes[i].time_s - keyframes[i - 1].time_s);
-      std::array<double, 7> v;
-      for (int j = 0; j < 7; ++j) v[j] = va[j] + w * (vb[j] - va[j]);
-      return geometry::LocationErrors::fromValues(v);
-    }
-  }
-  return keyframes.back().errors;
-}
+geometry::LocationErrors MachineTruth::keyframeAt(double t) const { return interpolateKeyframes(keyframes, t); }
 
 namespace {
 
@@ -187,20 +173,7 @@ MachineTruth loadMachineTruth(const std::string& path) {
     t.static_errors = readErrorVector(*s, "");
     s->finish();
   }
-  if (root.has("location_keyframes")) {
-    double last = -INFINITY;
-    for (auto& k : root.mapList("location_keyframes")) {
-      LocationKeyframeTruth f;
-      f.time_s = k.quantity("time", Dimension::Duration);
-      if (!(f.time_s > last)) k.fail("time", "keyframe times must increase");
-      last = f.time_s;
-      std::array<double, 7> v;
-      for (int j = 0; j < 7; ++j) v[j] = k.numberOr(geometry::LocationErrors::names()[j], 0.0);
-      f.errors = geometry::LocationErrors::fromValues(v);
-      k.finish();
-      t.keyframes.push_back(f);
-    }
-  }
+  if (root.has("location_keyframes")) t.keyframes = readLocationKeyframes(root, "location_keyframes");
   if (auto a = root.mapIfPresent("axes")) {
     const char axn[] = {'X', 'Y', 'Z'};
     const char* err[] = {"EX", "EY", "EZ", "EA", "EB", "EC"};

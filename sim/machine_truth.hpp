@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "geometry/location_errors.hpp"
+#include "sim/rigid_campaign.hpp"
 #include "sim/thermal_network.hpp"
 
 namespace probeloop::sim {
@@ -28,10 +29,6 @@ struct ErrorVector {
   bool any() const;
 };
 
-struct LocationKeyframeTruth {
-  double time_s = 0;
-  geometry::LocationErrors errors;
-};
 
 // Polynomial error of a linear axis as a function of its machine coordinate (mm):
 // sum_k coeff[k] * pos^k, in um (translations) or urad (rotations).
@@ -111,7 +108,7 @@ struct ArtifactTruth {
 struct MachineTruth {
   std::string file;
   ErrorVector static_errors;                    // constant
-  std::vector<LocationKeyframeTruth> keyframes; // piecewise linear in time
+  std::vector<LocationKeyframe> keyframes;      // piecewise linear in time
   AxisErrorPolynomials axes;
   double EC0Y_urad = 0, EB0Z_urad = 0, EA0Z_urad = 0;  // squareness (right-hand rotations)
   ThermalTruth thermal;

@@ -15,7 +15,7 @@ namespace probeloop::sim {
 using Eigen::Vector3d;
 using geometry::LocationErrors;
 
-LocationErrors RigidTruth::at(double t) const {
+LocationErrors interpolateKeyframes(const std::vector<LocationKeyframe>& keyframes, double t) {
   if (keyframes.empty()) return {};
   if (t <= keyframes.front().time_s) return keyframes.front().errors;
   if (t >= keyframes.back().time_s) return keyframes.back().errors;
@@ -33,16 +33,12 @@ LocationErrors RigidTruth::at(double t) const {
   return keyframes.back().errors;
 }
 
-RigidTruth loadRigidTruth(const std::string& path) {
-  parts::YamlMap root(parts::loadYamlFile(path), path, "");
-  root.choice("kind", {"rigid_location_truth"});
-  RigidTruth t;
-  t.per_point = root.choice("sample", {"per_cycle", "per_point"}) == "per_point";
-  t.probe_noise_um = root.quantity("probe_noise", Dimension::Micrometre);
-  if (t.probe_noise_um < 0) root.fail("probe_noise", "must not be negative");
-  t.quantise = root.boolean("quantise");
+LocationErrors RigidTruth::at(double t) const { return interpolateKeyframes(keyframes, t); }
+
+std::vector<LocationKeyframe> readLocationKeyframes(parts::YamlMap& parent, const std::string& key) {
+  std::vector<LocationKeyframe> out;
   double last = -INFINITY;
-  for (auto& k : root.mapList("location_errors")) {
+  for (auto& k : parent.mapList(key)) {
     LocationKeyframe f;
     f.time_s = k.quantity("time", Dimension::Duration);
     if (!(f.time_s > last)) k.fail("time", "keyframe times must increase");
@@ -54,8 +50,20 @@ RigidTruth loadRigidTruth(const std::string& path) {
     }
     f.errors = LocationErrors::fromValues(v);
     k.finish();
-    t.keyframes.push_back(f);
+    out.push_back(f);
   }
+  return out;
+}
+
+RigidTruth loadRigidTruth(const std::string& path) {
+  parts::YamlMap root(parts::loadYamlFile(path), path, "");
+  root.choice("kind", {"rigid_location_truth"});
+  RigidTruth t;
+  t.per_point = root.choice("sample", {"per_cycle", "per_point"}) == "per_point";
+  t.probe_noise_um = root.quantity("probe_noise", Dimension::Micrometre);
+  if (t.probe_noise_um < 0) root.fail("probe_noise", "must not be negative");
+  t.quantise = root.boolean("quantise");
+  t.keyframes = readLocationKeyframes(root, "location_errors");
   root.finish();
   return t;
 }

@@ -11,6 +11,7 @@
 
 #include "geometry/location_errors.hpp"
 #include "parts/plan_manifest.hpp"
+#include "parts/yaml_reader.hpp"
 
 namespace probeloop::sim {
 
@@ -18,6 +19,12 @@ struct LocationKeyframe {
   double time_s = 0;
   geometry::LocationErrors errors;
 };
+
+// Piecewise linear in time between keyframes, constant outside (zero without keyframes).
+geometry::LocationErrors interpolateKeyframes(const std::vector<LocationKeyframe>& k, double time_s);
+// A YAML list of keyframes {time, EX0C_um, ..., EC0C_urad} (absent values 0), times
+// increasing; InputError with file:line otherwise.
+std::vector<LocationKeyframe> readLocationKeyframes(parts::YamlMap& parent, const std::string& key);
 
 // Schema: docs/formats.md#rigid-truth.
 struct RigidTruth {

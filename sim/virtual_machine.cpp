@@ -162,18 +162,25 @@ class VirtualMachine : public gcode::MachineInterface {
     ev.approach = dir;
     ev.pretravel_um = pre_um;
     fillTruth(ev, art);
+    return latchTrigger(ev, dir, s_trig * len, F);
+  }
+
+  // The controller latches the trigger: repeatability noise along the approach, the axes'
+  // resolution, the clock at the trigger, the event for the truth and the next log line.
+  gcode::ProbeOutcome latchTrigger(ProbeEvent ev, const Vector3d& dir, double travel_mm, double F) {
     ev.noise_um = tr_.probe.noise_um > 0 ? tr_.probe.noise_um * normal_(noise_rng_) : 0.0;
-    Vector3d latched = g0 + s_trig * (g1 - g0) + ev.noise_um * 1e-3 * dir;
+    Vector3d latched = pos_.xyz_mm + travel_mm * dir + ev.noise_um * 1e-3 * dir;
     if (tr_.probe.quantise) {
       const double q[3] = {m_.x.resolution_mm, m_.y.resolution_mm, m_.z.resolution_mm};
       for (int k = 0; k < 3; ++k) latched(k) = std::round(latched(k) / q[k]) * q[k];
     }
-    advance(s_trig * len / F * 60.0);
+    advance(travel_mm / F * 60.0);
     ev.time_s = t_;
     ev.reported_tip_mm = latched - Vector3d(0, 0, currentToolLength());
     events_.push_back(ev);
     pending_ = static_cast<long>(events_.size()) - 1;
     pos_.xyz_mm = latched;
+    gcode::ProbeOutcome out;
     out.contact = true;
     out.stop = pos_;
     return out;
@@ -658,21 +665,7 @@ class VirtualMachine : public gcode::MachineInterface {
     ev.atc_um = atc_um_;
     ev.artifact_dT_K = nodeRise(tr_.artifact.node);
     ev.apparent = ev.location;
-    ev.noise_um = tr_.probe.noise_um > 0 ? tr_.probe.noise_um * normal_(noise_rng_) : 0.0;
-    Vector3d latched = pos_.xyz_mm + s_trig * dir + ev.noise_um * 1e-3 * dir;
-    if (tr_.probe.quantise) {
-      const double q[3] = {m_.x.resolution_mm, m_.y.resolution_mm, m_.z.resolution_mm};
-      for (int k = 0; k < 3; ++k) latched(k) = std::round(latched(k) / q[k]) * q[k];
-    }
-    advance(s_trig / F * 60.0);
-    ev.time_s = t_;
-    ev.reported_tip_mm = latched - Vector3d(0, 0, currentToolLength());
-    events_.push_back(ev);
-    pending_ = static_cast<long>(events_.size()) - 1;
-    pos_.xyz_mm = latched;
-    out.contact = true;
-    out.stop = pos_;
-    return out;
+    return latchTrigger(ev, dir, s_trig, F);
   }
 
  public:
