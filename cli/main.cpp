@@ -100,7 +100,7 @@ int cmdSynth(const std::string& manifest_file, const std::string& truth_file,
 
 int cmdSimulate(const std::string& program_file, const std::string& machine_file,
                 const std::string& part_file, const std::string& truth_file, const std::string& out_dir,
-                std::uint64_t seed, const std::string& cmm_file) {
+                std::uint64_t seed, const std::string& cmm_file, bool trace) {
   const auto machine = parts::loadMachine(machine_file);
   const auto truth = sim::loadMachineTruth(truth_file);
   const std::string kind = parts::partKind(part_file);
@@ -116,7 +116,11 @@ int cmdSimulate(const std::string& program_file, const std::string& machine_file
   } else {
     throw InputError(part_file, 1, "kind: '" + kind + "' cannot stand on the simulated table (sphere_artifact or workpiece)");
   }
-  if (!cmm_file.empty()) part.cmm_points = sim::readCmmPoints(cmm_file);
+  if (!cmm_file.empty()) {
+    part.cmm_points = sim::readCmmPoints(cmm_file);
+    part.cmm_points_file = cmm_file;
+  }
+  part.trace = trace;
   const auto s = sim::simulateProgram(program_file, readFile(program_file), machine, part, truth, seed);
   const std::string log_file = fs::path(s.log_name).filename().string();
   writeFileAtomic(join(out_dir, log_file), s.log_text);
@@ -127,6 +131,10 @@ int cmdSimulate(const std::string& program_file, const std::string& machine_file
   if (workpiece) {
     writeFileAtomic(join(out_dir, "cuts.json"), s.cuts_json);
     extra += ", cuts.json";
+  }
+  if (trace) {
+    writeFileAtomic(join(out_dir, "trace.csv"), s.trace_csv);
+    extra += ", trace.csv";
   }
   if (!s.cmm_csv.empty()) {
     writeFileAtomic(join(out_dir, "cmm_export.csv"), s.cmm_csv);
@@ -269,12 +277,14 @@ int main(int argc, char** argv) {
   simc->add_option("program", program, "G-code program (.ngc LinuxCNC, .nc Fanuc macro B)")->required()->check(CLI::ExistingFile);
   simc->add_option("--machine", machine, "machine description (YAML)")->required()->check(CLI::ExistingFile);
   std::string cmm_points;
+  bool sim_trace = false;
   simc->add_option("--part", part, "what stands on the table: a sphere artifact or a workpiece (YAML)")->required()->check(CLI::ExistingFile);
   simc->add_option("--truth", truth, "the machine's error effects (YAML, kind: machine_truth)")->required()->check(CLI::ExistingFile);
   simc->add_option("--out", out, "output folder")->capture_default_str();
   simc->add_option("--seed", seed, "random seed")->capture_default_str();
   simc->add_option("--cmm-points", cmm_points, "workpiece: CMM points to measure after the program "
                    "(feature,point,x_mm,y_mm,z_mm,nx,ny,nz)")->check(CLI::ExistingFile);
+  simc->add_flag("--trace", sim_trace, "also write trace.csv: every motion, dwell and tool change with its time and line");
 
   auto* ev = app.add_subcommand("evaluate", "Location errors of the C axis from probe logs or points CSV");
   ev->add_option("points", points, "LinuxCNC log, Fanuc DPRNT output or points CSV")->required()->check(CLI::ExistingFile);
@@ -312,7 +322,7 @@ int main(int argc, char** argv) {
     if (*plan) return cmdPlan(artifact, machine, out, dialect);
     if (*res) return cmdResolution(artifact, machine, step_um);
     if (*syn) return cmdSynth(manifest, truth, out, seed);
-    if (*simc) return cmdSimulate(program, machine, part, truth, out, seed, cmm_points);
+    if (*simc) return cmdSimulate(program, machine, part, truth, out, seed, cmm_points, sim_trace);
     if (*fit) return cmdFit(fa);
     if (*ev) return cmdEvaluate(points, manifest, out, format, free_radius, scene, exaggeration);
   } catch (const std::exception& e) {

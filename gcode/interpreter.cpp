@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <numbers>
 #include <optional>
+#include <set>
 #include <variant>
 #include <algorithm>
 
@@ -36,6 +37,15 @@ bool isActiveComment(const std::string& body, ProgramDialect d) {
       return true;
   }
   return false;
+}
+
+// A small non-negative integer written in the program (labels, loop numbers, parameter
+// numbers); nullopt when it is not one.
+std::optional<int> smallInt(const std::string& digits) {
+  if (digits.empty() || digits.size() > 6) return std::nullopt;
+  for (char c : digits)
+    if (!std::isdigit(static_cast<unsigned char>(c))) return std::nullopt;
+  return std::stoi(digits);
 }
 
 // An error raised by the program itself (alarm, ABORT, probe without contact): the
@@ -113,6 +123,7 @@ class Execution {
              " blocks without ending; an endless loop?");
       const auto& line = in_.lines_[pc_];
       line_ = line.number;
+      m_.atLine(line_);
       std::size_t next = pc_ + 1;
       try {
         if (executeLine(line, next)) {
@@ -124,7 +135,7 @@ class Execution {
         if (w.rfind(in_.file_ + ":", 0) == 0) throw;
         throw SafetyError(in_.file_ + ":" + std::to_string(line_) + ": " + w);
       } catch (const InputError& e) {
-        if (e.line() > 0 || !e.file().empty()) throw;
+        if (e.line() > 0 && e.file() == in_.file_) throw;
         fail(e.what());
       }
       pc_ = next;
@@ -147,6 +158,7 @@ class Execution {
   double tool_length_ = 0;
   int tool_in_spindle_ = 0, tool_selected_ = 0;
   double spindle_rpm_ = 0;
+  int spindle_dir_ = 0;  // +1 M3, -1 M4, 0 stopped
   MachinePosition pos_;  // gauge line, machine coordinates
   bool log_open_ = false;
   bool seen_program_number_ = false;
@@ -181,7 +193,9 @@ class Execution {
     if (c.i == b) fail("expected a number at column " + std::to_string(b + 1) + " of '" + c.s + "'");
     const std::string t = c.s.substr(b, c.i - b);
     if (t == "." || std::count(t.begin(), t.end(), '.') > 1) fail("'" + t + "' is not a number");
-    return std::stod(t);
+    const double v = std::strtod(t.c_str(), nullptr);
+    if (!std::isfinite(v)) fail("'" + t + "' is not a finite number");
+    return v;
   }
 
   double readParam(Cursor& c) {  // after '#'
@@ -224,7 +238,11 @@ class Execution {
         const std::string fn = f;
         const double a = bracket(c);
         if (fn == "ATAN") {
-          if (c.take("/")) return std::atan2(a, bracket(c)) * 180.0 / kPi;
+          if (c.take("/")) {
+            const double deg = std::atan2(a, bracket(c)) * 180.0 / kPi;
+            // Fanuc answers in 0..360, LinuxCNC in -180..180.
+            return in_.dialect_ == ProgramDialect::FanucMacroB && deg < 0 ? deg + 360.0 : deg;
+          }
           if (in_.dialect_ == ProgramDialect::LinuxCnc) fail("ATAN needs the form ATAN[y]/[x]");
           return std::atan(a) * 180.0 / kPi;
         }
@@ -237,8 +255,10 @@ class Execution {
         if (fn == "SIN") return std::sin(a * kPi / 180.0);
         if (fn == "TAN") return std::tan(a * kPi / 180.0);
         if (fn == "EXP") return std::exp(a);
-        if (fn == "FIX") return std::floor(a);
-        if (fn == "FUP") return std::ceil(a);
+        // LinuxCNC rounds down / up; Fanuc truncates toward / away from zero.
+        const bool fanuc = in_.dialect_ == ProgramDialect::FanucMacroB;
+        if (fn == "FIX") return fanuc ? std::trunc(a) : std::floor(a);
+        if (fn == "FUP") return fanuc ? (a < 0 ? std::floor(a) : std::ceil(a)) : std::ceil(a);
         if (fn == "ROUND") return std::round(a);
         if (fn == "LN") {
           if (a <= 0) fail("LN of a non-positive value");
@@ -254,7 +274,12 @@ class Execution {
 
   double power(Cursor& c) {
     double v = primary(c);
-    while (c.take("**")) v = std::pow(v, primary(c));
+    while (c.take("**")) {
+      const double e = primary(c);
+      if (v < 0 && e != std::floor(e)) fail("a negative number to a non-integer power is undefined");
+      v = std::pow(v, e);
+      if (!std::isfinite(v)) fail("** overflows");
+    }
     return v;
   }
   double product(Cursor& c) {
@@ -268,7 +293,8 @@ class Execution {
       } else if (c.take("MOD")) {
         const double d = power(c);
         if (d == 0) fail("MOD by zero");
-        v = v - d * std::floor(v / d);
+        v = std::fmod(v, d);  // LinuxCNC: fmod, then made non-negative with |d|
+        if (v < 0) v += std::fabs(d);
       } else return v;
     }
   }
@@ -295,9 +321,17 @@ class Execution {
   double expression(Cursor& c) {
     double v = comparison(c);
     for (;;) {
-      if (c.take("AND")) v = (v != 0) && (comparison(c) != 0);
-      else if (c.take("OR")) v = (v != 0) || (comparison(c) != 0);
-      else if (c.take("XOR")) v = (v != 0) != (comparison(c) != 0);
+      // Evaluate the right side first: a short circuit would leave the cursor before it.
+      if (c.take("AND")) {
+        const double r = comparison(c);
+        v = (v != 0) && (r != 0);
+      } else if (c.take("OR")) {
+        const double r = comparison(c);
+        v = (v != 0) || (r != 0);
+      } else if (c.take("XOR")) {
+        const double r = comparison(c);
+        v = (v != 0) != (r != 0);
+      }
       else return v;
     }
   }
@@ -390,7 +424,9 @@ class Execution {
           i = 1;
           while (i < code.size() && std::isdigit(static_cast<unsigned char>(code[i]))) ++i;
           if (i > 1) {
-            const int n = std::stoi(code.substr(1, i - 1));
+            const auto parsed = smallInt(code.substr(1, i - 1));
+            if (!parsed) fail("label N" + code.substr(1, i - 1) + " is not a number of at most 6 digits");
+            const int n = *parsed;
             if (labels_.count(n)) fail("label N" + std::to_string(n) + " appears twice");
             labels_[n] = k;
           }
@@ -399,10 +435,14 @@ class Execution {
         if (rest.rfind("WHILE", 0) == 0) {
           const std::size_t d = rest.rfind("DO");
           if (d == std::string::npos) fail("WHILE without DOm");
-          fanuc_do.push_back({std::stoi(rest.substr(d + 2)), k});
+          const auto m = smallInt(rest.substr(d + 2));
+          if (!m || *m < 1 || *m > 3) fail("WHILE [..] DOm needs m = 1, 2 or 3");
+          fanuc_do.push_back({*m, k});
         } else if (rest.rfind("END", 0) == 0 && rest.size() > 3 &&
                    std::isdigit(static_cast<unsigned char>(rest[3]))) {
-          const int m = std::stoi(rest.substr(3));
+          const auto parsed = smallInt(rest.substr(3));
+          if (!parsed) fail("END" + rest.substr(3) + ": expected ENDm with m = 1, 2 or 3");
+          const int m = *parsed;
           if (fanuc_do.empty() || fanuc_do.back().first != m)
             fail("END" + std::to_string(m) + " without a matching WHILE ... DO" + std::to_string(m));
           jump_[fanuc_do.back().second] = k;
@@ -534,8 +574,8 @@ class Execution {
     }
     if (rest.rfind("DPRNT[", 0) == 0) {
       if (!log_open_) fail("DPRNT before POPEN");
-      m_.log(dprnt(rest.substr(6, rest.size() - 7)));
       if (rest.back() != ']') fail("DPRNT[ is not closed by ]");
+      m_.log(dprnt(rest.substr(6, rest.size() - 7)));
       return true;
     }
     if (rest.rfind("M98", 0) == 0 || rest.rfind("M99", 0) == 0 || rest.rfind("G65", 0) == 0)
@@ -616,7 +656,9 @@ class Execution {
         } else if (std::isdigit(static_cast<unsigned char>(text[i + 1]))) {
           std::size_t k = i + 1;
           while (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k]))) ++k;
-          out += fmtLf(in_.parameter(std::stoi(text.substr(i + 1, k - i - 1))));
+          const auto n = smallInt(text.substr(i + 1, k - i - 1));
+          if (!n) fail("LOG names #" + text.substr(i + 1, k - i - 1) + ", which is not a parameter number");
+          out += fmtLf(in_.parameter(*n));
           i = k;
           continue;
         }
@@ -672,7 +714,12 @@ class Execution {
   struct Words {
     std::vector<double> g, m;
     std::map<char, double> v;
+    std::set<char> used;
     bool has(char k) const { return v.count(k) > 0; }
+    double take(char k) {
+      used.insert(k);
+      return v.at(k);
+    }
   };
 
   bool block(const std::string& code) {
@@ -689,12 +736,19 @@ class Execution {
         fail("expected a word letter at column " + std::to_string(c.i + 1) + " of '" + code + "'");
       ++c.i;
       if (c.peek() == '=') fail("unexpected '=' in '" + code + "'");
+      const std::size_t value_at = c.i;
       const double v = wordValue(c);
+      static const std::string lengths = "XYZBCIJR";
+      if (in_.dialect_ == ProgramDialect::FanucMacroB && lengths.find(letter) != std::string::npos && v != 0 &&
+          code.substr(value_at, c.i - value_at).find_first_of(".#[") == std::string::npos)
+        fail(std::string("'") + letter + code.substr(value_at, c.i - value_at) +
+             "' has no decimal point: a Fanuc control reads it in least input increments (um), "
+             "not mm; write it with a point");
       if (letter == 'G') w.g.push_back(std::round(v * 10) / 10);
       else if (letter == 'M') w.m.push_back(v);
       else if (letter == 'N') continue;
       else {
-        static const std::string allowed = "XYZBCFSTHPLIJRK";
+        static const std::string allowed = "XYZBCFSTHPLIJR";
         if (allowed.find(letter) == std::string::npos)
           fail("word '" + std::string(1, letter) + "' is not modelled by the simulator");
         if (w.v.count(letter)) fail("word '" + std::string(1, letter) + "' appears twice");
@@ -706,11 +760,27 @@ class Execution {
 
   static bool isG(double g, double want) { return std::fabs(g - want) < 1e-6; }
 
+  // A word that must be a whole number in a sane range (tool, offset, P of G10...).
+  int wholeWord(Words& w, char k, int lo, int hi) {
+    const double v = w.take(k);
+    if (!(v >= lo && v <= hi) || std::fabs(v - std::round(v)) > 1e-9)
+      fail(std::string(1, k) + formatG(v) + ": expected a whole number " + std::to_string(lo) + ".." + std::to_string(hi));
+    return static_cast<int>(std::lround(v));
+  }
+  static std::string formatG(double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%g", v);
+    return b;
+  }
+
   bool execute(Words& w) {
-    bool g53 = false, g31 = false, g10 = false, g4 = false;
+    bool g53 = false, g31 = false, g10 = false, g4 = false, g43 = false;
     std::optional<double> motion;
     for (double g : w.g) {
-      if (isG(g, 0) || isG(g, 1) || isG(g, 2) || isG(g, 3) || isG(g, 80)) motion = g;
+      if (isG(g, 0) || isG(g, 1) || isG(g, 2) || isG(g, 3)) motion = g;
+      else if (isG(g, 80) && in_.dialect_ == ProgramDialect::LinuxCnc) motion = g;
+      else if (isG(g, 80)) {
+      }  // Fanuc: cancels canned cycles only; none are modelled
       else if ((isG(g, 38.2) || isG(g, 38.3)) && in_.dialect_ == ProgramDialect::LinuxCnc) motion = g;
       else if (isG(g, 31) && in_.dialect_ == ProgramDialect::FanucMacroB) g31 = true;
       else if (isG(g, 90)) absolute_ = true;
@@ -719,64 +789,97 @@ class Execution {
       } else if (isG(g, 20)) fail("G20 (inch) is not modelled by the simulator; the planner writes G21");
       else if (isG(g, 18) || isG(g, 19)) fail("planes other than G17 are not modelled by the simulator");
       else if (isG(g, 49)) tool_length_ = 0;
-      else if (isG(g, 43)) {
-        const int h = w.has('H') ? static_cast<int>(std::lround(w.v['H'])) : tool_in_spindle_;
-        tool_length_ = m_.toolLength(h);
-      } else if (isG(g, 53)) g53 = true;
+      else if (isG(g, 43)) g43 = true;
+      else if (isG(g, 53)) g53 = true;
       else if (g >= 54 - 1e-6 && g <= 59 + 1e-6 && isG(g, std::round(g))) wcs_ = static_cast<int>(std::lround(g)) - 53;
       else if (isG(g, 10)) g10 = true;
       else if (isG(g, 4)) g4 = true;
       else fail("G" + fmtG(g) + " is not modelled by the simulator");
     }
-    if (w.has('F')) feed_ = w.v['F'];
-    if (w.has('T')) tool_selected_ = static_cast<int>(std::lround(w.v['T']));
+    if (g43) {
+      const int h = w.has('H') ? wholeWord(w, 'H', 0, 9999) : tool_in_spindle_;
+      tool_length_ = m_.toolLength(h);
+    }
+    if (w.has('F')) {
+      feed_ = w.take('F');
+      if (feed_ < 0) fail("F must not be negative");
+    }
+    if (w.has('T')) tool_selected_ = wholeWord(w, 'T', 0, 9999);
+    bool spindle_word = false, end = false;
     if (w.has('S')) {
-      spindle_rpm_ = w.v['S'];
+      spindle_rpm_ = w.take('S');
+      if (spindle_rpm_ < 0) fail("S must not be negative");
     }
     for (double m : w.m) {
       const int mi = static_cast<int>(std::lround(m));
+      if (std::fabs(m - mi) > 1e-9) fail("M" + formatG(m) + " is not modelled by the simulator");
       if (mi == 6) {
         m_.toolChange(tool_selected_);
         tool_in_spindle_ = tool_selected_;
-      } else if (mi == 3 || mi == 4) m_.spindle(mi == 3 ? spindle_rpm_ : -spindle_rpm_);
-      else if (mi == 5) m_.spindle(0);
-      else if (mi == 8) m_.coolant(true);
+      } else if (mi == 3 || mi == 4) {
+        spindle_dir_ = mi == 3 ? 1 : -1;
+        spindle_word = true;
+        m_.spindle(spindle_dir_ * spindle_rpm_);
+      } else if (mi == 5) {
+        spindle_dir_ = 0;
+        spindle_word = true;
+        m_.spindle(0);
+      } else if (mi == 8) m_.coolant(true);
       else if (mi == 9) m_.coolant(false);
-      else if (mi == 2 || mi == 30) return true;
+      else if (mi == 2 || mi == 30) end = true;  // after the rest of the line
       else if (mi == 19) {
       }  // spindle orientation: the probe's angular position is fixed anyway
       else fail("M" + std::to_string(mi) + " is not modelled by the simulator");
     }
+    // A new S while the spindle turns takes effect at once.
+    if (w.has('S') && !spindle_word && spindle_dir_ != 0) m_.spindle(spindle_dir_ * spindle_rpm_);
+    const char ax[] = {'X', 'Y', 'Z', 'B', 'C'};
     if (g10) {
-      if (!w.has('L') || std::lround(w.v['L']) != 2 || !w.has('P'))
+      if (!w.has('L') || !w.has('P') || wholeWord(w, 'L', 0, 99) != 2)
         fail("only G10 L2 Pn (set a work offset) is modelled");
-      int p = static_cast<int>(std::lround(w.v['P']));
-      if (p == 0) p = wcs_;
-      if (p < 1 || p > 6) fail("G10 L2 P" + std::to_string(p) + ": P must be 1..6");
-      const char ax[] = {'X', 'Y', 'Z', 'B', 'C'};
+      int p = wholeWord(w, 'P', 0, 6);
+      if (p == 0) {
+        if (in_.dialect_ == ProgramDialect::FanucMacroB)
+          fail("G10 L2 P0 is the external offset on a Fanuc control; it is not modelled");
+        p = wcs_;
+      }
       for (int a = 0; a < 5; ++a)
-        if (w.has(ax[a])) offsets_[p][a] = w.v[ax[a]];
-      return false;
+        if (w.has(ax[a])) offsets_[p][a] = w.take(ax[a]);
+      finishWords(w);
+      return end;
     }
     if (g4) {
+      // LinuxCNC: G4 P seconds, then the line's motion; Fanuc: G4 X seconds (X is the time).
       const char key = in_.dialect_ == ProgramDialect::LinuxCnc ? 'P' : 'X';
       if (!w.has(key)) fail(std::string("G4 needs ") + key + " (seconds)");
-      if (w.v[key] < 0) fail("G4 with a negative time");
-      m_.dwell(w.v[key]);
-      return false;
+      const double t = w.take(key);
+      if (t < 0) fail("G4 with a negative time");
+      m_.dwell(t);
     }
     if (motion) motion_ = *motion;
-    const bool axes = w.has('X') || w.has('Y') || w.has('Z') || w.has('B') || w.has('C');
-    if (!axes) {
-      if (g31 || g53) fail("G31/G53 without an axis word");
-      return false;
-    }
+    bool axes = false;
+    for (char a : ax) axes = axes || (w.has(a) && !w.used.count(a));
+    if (axes) move(w, g53, g31);
+    else if (g31 || g53) fail("G31/G53 without an axis word");
+    finishWords(w);
+    return end;
+  }
+
+  // Every word on a line must have done something: one that did not is refused, so a
+  // program the simulator misreads never runs silently.
+  void finishWords(const Words& w) {
+    for (const auto& [k, v] : w.v)
+      if (!w.used.count(k))
+        fail("word '" + std::string(1, k) + formatG(v) + "' has no effect on this line (not modelled)");
+  }
+
+  void move(Words& w, bool g53, bool g31) {
     MachinePosition to = target(w, g53);
     if (g31) {
       requireFeed();
       const auto r = m_.probe(to, feed_, ProbeMode::SkipToTarget);
       setProbeResult(r);
-      return false;
+      return;
     }
     if (isG(motion_, 0)) m_.rapid(to);
     else if (isG(motion_, 1)) {
@@ -793,12 +896,11 @@ class Execution {
         stop(in_.file_, line_, "G38.2 probe move finished without contact");
       in_.params_[5070] = r.contact ? 1 : 0;
       setProbeResult(r);
-      return false;
+      return;
     } else {
       fail("axis words with G80 active (no motion mode)");
     }
     pos_ = to;
-    return false;
   }
 
   void requireFeed() {
@@ -826,7 +928,8 @@ class Execution {
     const char ax[] = {'X', 'Y', 'Z', 'B', 'C'};
     for (int a = 0; a < 5; ++a) {
       if (!w.has(ax[a])) continue;
-      *dst[a] = absolute_ ? w.v[ax[a]] + off[static_cast<std::size_t>(a)] : cur[a] + w.v[ax[a]];
+      const double v = w.take(ax[a]);
+      *dst[a] = absolute_ ? v + off[static_cast<std::size_t>(a)] : cur[a] + v;
     }
     return t;
   }
@@ -847,7 +950,7 @@ class Execution {
     const Eigen::Vector2d a = pos_.xyz_mm.head<2>(), b = to.xyz_mm.head<2>();
     Eigen::Vector2d centre;
     if (w.has('R')) {
-      const double r = w.v['R'], d = (b - a).norm();
+      const double r = w.take('R'), d = (b - a).norm();
       if (d < 1e-9 || std::fabs(r) < d / 2 - 1e-9) fail("arc radius R is too small for the end point");
       const double h = std::sqrt(std::max(0.0, r * r - d * d / 4));
       const Eigen::Vector2d mid = (a + b) / 2, perp = Eigen::Vector2d(-(b - a).y(), (b - a).x()) / d;
@@ -856,7 +959,7 @@ class Execution {
       centre = mid + side * h * perp;
     } else {
       if (!w.has('I') && !w.has('J')) fail("G2/G3 needs I/J (centre) or R");
-      centre = a + Eigen::Vector2d(w.has('I') ? w.v['I'] : 0.0, w.has('J') ? w.v['J'] : 0.0);
+      centre = a + Eigen::Vector2d(w.has('I') ? w.take('I') : 0.0, w.has('J') ? w.take('J') : 0.0);
     }
     const double ra = (a - centre).norm(), rb = (b - centre).norm();
     if (ra < 1e-9) fail("arc with zero radius");
@@ -867,9 +970,12 @@ class Execution {
     if (clockwise) {
       if (sweep >= -1e-12) sweep -= 2 * kPi;
     } else if (sweep <= 1e-12) sweep += 2 * kPi;
+    if (ra > 1e5) fail("arc radius " + formatG(ra) + " mm is not plausible");
     const double tol = 1e-4;
     const double max_step = 2 * std::acos(std::max(-1.0, 1 - tol / ra));
-    const int n = std::max(1, static_cast<int>(std::ceil(std::fabs(sweep) / max_step)));
+    const double chords = std::ceil(std::fabs(sweep) / max_step);
+    if (!(chords <= 1e6)) fail("arc needs more than 1e6 chords within 0.1 um; not modelled");
+    const int n = std::max(1, static_cast<int>(chords));
     for (int k = 1; k <= n; ++k) {
       const double s = static_cast<double>(k) / n;
       MachinePosition p = to;

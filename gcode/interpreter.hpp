@@ -57,6 +57,8 @@ class MachineInterface {
   virtual void closeLog() = 0;
   // Where the machine stands when the program starts (gauge line, machine coordinates).
   virtual MachinePosition start() const { return {}; }
+  // The program line about to execute (for traces).
+  virtual void atLine(int /*line*/) {}
 };
 
 struct InterpreterResult {

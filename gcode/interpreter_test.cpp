@@ -71,6 +71,39 @@ TEST(Interpreter, ExpressionsFollowRs274Precedence) {
   EXPECT_EQ(in.parameter(7), 1);
 }
 
+TEST(Interpreter, LogicalOperatorsReadBothSidesAndModFollowsLinuxCnc) {
+  Recorder r;
+  Interpreter in(ProgramDialect::LinuxCnc, "t.ngc",
+                 "#1 = [0 AND 1]\n#2 = [1 OR 0]\n#3 = [0 OR 0 OR 1]\n#4 = [7 MOD -3]\n#5 = [-7 MOD 3]\n"
+                 "#6 = [FIX[-1.5] + FUP[-1.5]]\n#7 = ATAN[-1]/[-1]\nM2\n");
+  in.run(r);
+  EXPECT_EQ(in.parameter(1), 0);
+  EXPECT_EQ(in.parameter(2), 1);
+  EXPECT_EQ(in.parameter(3), 1);
+  EXPECT_EQ(in.parameter(4), 1);  // fmod(7, -3) = 1
+  EXPECT_EQ(in.parameter(5), 2);  // fmod(-7, 3) = -1, + |3|
+  EXPECT_EQ(in.parameter(6), -2 + -1);  // LinuxCNC: round down, round up
+  EXPECT_NEAR(in.parameter(7), -135, 1e-12);
+  // Fanuc truncates toward / away from zero and answers ATAN in 0..360.
+  Interpreter fa(ProgramDialect::FanucMacroB, "t.nc", "#1=FIX[-1.5]+FUP[-1.5]\n#2=ATAN[-1]/[-1]\nM30\n");
+  fa.run(r);
+  EXPECT_EQ(fa.parameter(1), -1 + -2);
+  EXPECT_NEAR(fa.parameter(2), 225, 1e-12);
+}
+
+TEST(Interpreter, DwellBeforeMotionEndAfterItAndSpeedChangesAtOnce) {
+  Recorder r;
+  Interpreter in(ProgramDialect::LinuxCnc, "t.ngc", "S1000 M3\nS2000\nG4 P1.5 G0 X10\nG0 X20 M2\nG0 X30\n");
+  in.run(r);
+  ASSERT_EQ(r.calls.size(), 5u);
+  EXPECT_EQ(r.calls[0], "S " + std::to_string(1000.0));
+  EXPECT_EQ(r.calls[1], "S " + std::to_string(2000.0));  // S while turning: at once
+  EXPECT_EQ(r.calls[2], "G4 " + std::to_string(1.5));
+  EXPECT_EQ(r.calls[3], "G0");
+  EXPECT_EQ(r.calls[4], "G0");  // the move on the M2 line runs, the line after it does not
+  EXPECT_EQ(r.targets.back().xyz_mm.x(), 20);
+}
+
 TEST(Interpreter, LinuxCncLoopsAndBranches) {
   Recorder r;
   Interpreter in(ProgramDialect::LinuxCnc, "t.ngc",
@@ -194,9 +227,17 @@ TEST(Interpreter, RefusesWhatItDoesNotModelWithTheLine) {
   expectInputError(ProgramDialect::LinuxCnc, "#1 = [1 +* 2]\n", "bad.ngc:1:");
   expectInputError(ProgramDialect::LinuxCnc, "G1 X5\n", "bad.ngc:1: a feed move without a feed rate");
   expectInputError(ProgramDialect::LinuxCnc, "#1 = [#<nope> + 1]\n", "#<nope> is read before it is set");
+  expectInputError(ProgramDialect::LinuxCnc, "G0 X1 K5\n", "bad.ngc:1: word 'K' is not modelled");
+  expectInputError(ProgramDialect::LinuxCnc, "G0 X1 H5\n", "bad.ngc:1: word 'H5' has no effect on this line");
+  expectInputError(ProgramDialect::LinuxCnc, "G1 X1 I2 F100\n", "bad.ngc:1: word 'I2' has no effect");
+  expectInputError(ProgramDialect::LinuxCnc, "#1 = [-8 ** 0.5]\n", "bad.ngc:1: a negative number to a non-integer power");
+  expectInputError(ProgramDialect::LinuxCnc, "T1.5 M6\n", "bad.ngc:1: T1.5: expected a whole number");
+  expectInputError(ProgramDialect::FanucMacroB, "G0 X10\n", "bad.ngc:1: 'X10' has no decimal point");
+  expectInputError(ProgramDialect::FanucMacroB, "WHILE [1 LT 2] DO\nEND1\n", "bad.ngc:1: WHILE [..] DOm needs m");
+  expectInputError(ProgramDialect::FanucMacroB, "N12345678 G0 X1.\n", "bad.ngc:1: label N12345678 is not a number");
   expectInputError(ProgramDialect::LinuxCnc, "T5 M6\nG43\n", "bad.ngc:2: no tool 5");
   expectInputError(ProgramDialect::FanucMacroB, "M98 P1000\n", "bad.ngc:1: subprogram calls");
-  expectInputError(ProgramDialect::FanucMacroB, "G38.2 X1 F100\n", "bad.ngc:1: G38.2 is not modelled");
+  expectInputError(ProgramDialect::FanucMacroB, "G38.2 X1. F100\n", "bad.ngc:1: G38.2 is not modelled");
   expectInputError(ProgramDialect::FanucMacroB, "GOTO 5\n", "bad.ngc:1: GOTO 5: no block N5");
 }
 

@@ -55,7 +55,19 @@ std::array<bool, 3> workpieceSideAxes(const std::string& code) {
   const auto open = code.find('['), close = code.rfind(']');
   if (open == std::string::npos || close == std::string::npos || close < open)
     throw std::invalid_argument("expected a code like \"V[w C' Y X Z t]\" (ISO 10791-1: axes from the workpiece w to the tool t)");
-  const std::string body = code.substr(open + 1, close - open - 1);
+  // The prime as ISO documents print it (U+2032, bytes E2 80 B2) is the ASCII apostrophe.
+  const std::string raw = code.substr(open + 1, close - open - 1), prime = "\u2032";
+  std::string body;
+  for (std::size_t k = 0; k < raw.size();) {
+    if (raw.compare(k, prime.size(), prime) == 0) {
+      body += '\'';
+      k += prime.size();
+      continue;
+    }
+    if (static_cast<unsigned char>(raw[k]) >= 0x80)
+      throw std::invalid_argument("unexpected non-ASCII character in the code");
+    body += raw[k++];
+  }
   // Tokens: letters with optional digits and prime; brackets group gantry axes.
   std::vector<std::string> tokens;
   std::string cur;

@@ -23,7 +23,10 @@ std::vector<CmmPoint> readCmmPoints(const std::string& path) {
     CmmPoint p;
     p.line = r.line;
     p.feature = r.fields[static_cast<std::size_t>(t.column("feature"))];
-    p.point = static_cast<int>(t.number(r, t.column("point")));
+    const double point = t.number(r, t.column("point"));
+    if (!(point >= 0 && point <= 1e6) || point != std::floor(point))
+      throw InputError(path, r.line, "point must be a whole number 0..1000000");
+    p.point = static_cast<int>(point);
     p.nominal_mm = Eigen::Vector3d(t.number(r, t.column("x_mm")), t.number(r, t.column("y_mm")), t.number(r, t.column("z_mm")));
     p.normal = Eigen::Vector3d(t.number(r, t.column("nx")), t.number(r, t.column("ny")), t.number(r, t.column("nz")));
     if (std::fabs(p.normal.norm() - 1.0) > 1e-6)
@@ -45,6 +48,9 @@ std::string measureOnCmm(const Stock& stock, const parts::Workpiece& w, const st
   for (const auto& p : points) {
     const Eigen::Vector3d from = p.nominal_mm + search * p.normal;
     const auto s = stock.firstMaterial(from, -p.normal, 2 * search);
+    if (s && *s <= 0)
+      throw InputError(file, p.line, "CMM point " + p.feature + " " + std::to_string(p.point) + ": the approach starts in material " +
+                                         formatNumber(search) + " mm outside the nominal point (a narrow slot, or a wrong normal)");
     if (!s)
       throw InputError(file, p.line, "CMM point " + p.feature + " " + std::to_string(p.point) +
                                          ": no surface within " + formatNumber(search) + " mm of the nominal point along the normal");

@@ -55,9 +55,8 @@ ErrorVector readErrorVector(YamlMap& m, const std::string& suffix) {
   return e;
 }
 
-std::vector<double> numberList(YamlMap& m, const std::string& key) {
-  return m.quantityList(key, Dimension::Micrometre);  // bare numbers: coefficients as written
-}
+// Bare numbers: coefficients as written (um/mm^k or urad/mm^k).
+std::vector<double> numberList(YamlMap& m, const std::string& key, Dimension d) { return m.quantityList(key, d); }
 
 void loadThermal(YamlMap t, ThermalTruth& th) {
   th.present = true;
@@ -125,10 +124,13 @@ void loadThermal(YamlMap t, ThermalTruth& th) {
     for (auto& s : t.mapList("sources")) {
       HeatSourceSpec h;
       h.node = node(s, "node", false);
-      const auto in = s.choice("input", {"c_axis_speed", "spindle_speed", "mwf", "constant"});
+      const auto in = s.choice("input", {"c_axis_speed", "spindle_speed", "axis_speed", "mwf", "constant"});
       if (in == "c_axis_speed" || in == "spindle_speed") {
         h.input = in == "c_axis_speed" ? HeatInput::CAxisRpm : HeatInput::SpindleRpm;
         h.gain = s.number("W_per_rpm");
+      } else if (in == "axis_speed") {
+        h.input = HeatInput::AxisSpeed;  // friction in guides and screws while X/Y/Z move
+        h.gain = s.number("W_per_m_per_min");
       } else {
         h.input = in == "mwf" ? HeatInput::Mwf : HeatInput::Constant;
         h.gain = s.number("W");
@@ -183,7 +185,7 @@ MachineTruth loadMachineTruth(const std::string& path) {
       for (int e = 0; e < 6; ++e) {
         const std::string key = std::string(err[e]) + axn[i] + (e < 3 ? "_um" : "_urad");
         if (m->has(key)) {
-          t.axes.coeff[i][e] = numberList(*m, key);
+          t.axes.coeff[i][e] = numberList(*m, key, e < 3 ? Dimension::Micrometre : Dimension::Microradian);
           t.axes.any = true;
         } else {
           m->numberOr(key, 0);  // allowed key
@@ -248,7 +250,8 @@ MachineTruth loadMachineTruth(const std::string& path) {
       const std::string n = a->string("node");
       t.artifact.node = t.thermal.nodeIndex(n);
       if (t.artifact.node < 0) a->fail("node", "no thermal node named '" + n + "' (define thermal: before)");
-      t.artifact.alpha_per_K = a->number("alpha_um_per_m_K") * 1e-6;
+      if (a->has("alpha_um_per_m_K")) t.artifact.alpha_per_K = a->number("alpha_um_per_m_K") * 1e-6;
+      else a->numberOr("alpha_um_per_m_K", 0);  // allowed: a workpiece's material gives it
     }
     if (auto p = a->mapIfPresent("placement_error")) {
       t.artifact.placement_error_mm = Eigen::Vector3d(p->quantityOr("x", Dimension::Micrometre, 0),

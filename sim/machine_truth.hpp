@@ -52,19 +52,20 @@ struct EnvironmentProfile {
   double at(double t_s) const;
 };
 
-enum class HeatInput { CAxisRpm, SpindleRpm, Mwf, Constant };
+enum class HeatInput { CAxisRpm, SpindleRpm, AxisSpeed, Mwf, Constant };
 
 struct HeatSourceSpec {
   int node = 0;
   HeatInput input = HeatInput::Constant;
-  double gain = 0;  // W per rpm (|speed|), W when the MWF is on, W for constant
+  double gain = 0;  // W per rpm (|speed|), W per m/min of path speed, W when the MWF is on, W
 };
 
 struct SensorSpec {
   std::string column;  // e.g. T_env_C (inputs CSV)
   int node = -1;       // -1 = environment
   double noise_K = 0;
-  std::optional<double> offset_K;  // absent = drawn uniformly in +-0.5 K (DS1820 accuracy)
+  std::optional<double> offset_K;  // `random` in the file = drawn uniformly in +-0.5 K (DS1820
+                                   // accuracy); absent in the file = 0
 };
 
 struct ThermalTruth {
@@ -101,7 +102,7 @@ struct ProbeTruth {
 
 struct ArtifactTruth {
   int node = -1;            // node whose temperature rise the artifact and table share
-  double alpha_per_K = 0;   // expansion coefficient (steel 11.5e-6)
+  std::optional<double> alpha_per_K;  // expansion coefficient; absent: the workpiece material's
   Eigen::Vector3d placement_error_mm = Eigen::Vector3d::Zero();  // where it really sits
 };
 

@@ -218,7 +218,42 @@ TEST(Machining, AngularErrorsActThroughTheAbbeLeverOfTheirSide) {
   EXPECT_EQ(parts::workpieceSideAxes("V[w X' Y' b Z t]"), (std::array<bool, 3>{true, true, false}));
   EXPECT_EQ(parts::workpieceSideAxes("V[w C2' B' b [Y1 Y2] X [Z1 Z2] (C1) t]"), (std::array<bool, 3>{false, false, false}));
   EXPECT_EQ(parts::workpieceSideAxes("V[w Y' C' X Z t]"), (std::array<bool, 3>{false, true, false}));
+  EXPECT_EQ(parts::workpieceSideAxes("V[w X\u2032 Y\u2032 Z t]"), (std::array<bool, 3>{true, true, false}));
   EXPECT_THROW(parts::workpieceSideAxes("w X Y Z t"), std::invalid_argument);
+}
+
+// Axis motion heats a node: 10 W per m/min at F1000 for 720 s of air moves; the node's
+// sensor (no noise, no offset) follows dT = Q/G (1 - exp(-t G/C)), Q = 10 W, tau = 400 s.
+TEST(Machining, AxisMotionIsAHeatSource) {
+  std::string prog = "G21 G90\nG0 X-300 Y0 Z200\n";
+  for (int k = 0; k < 10; ++k) prog += "G1 X300 F1000\nG1 X-300\n";  // 20 x 600 mm at 1 m/min = 720 s
+  prog += "M2\n";
+  const auto r = machine(truthFrom(R"(
+thermal:
+  environment: {mean_C: 20}
+  nodes: [{name: screws, capacity_J_per_K: 4000, to_environment_W_per_K: 10}]
+  sources: [{node: screws, input: axis_speed, W_per_m_per_min: 10}]
+  sensors: [{column: T_screws_C, node: screws}]
+inputs_rate: 60 s
+)"), block(0.0), prog, {}, "parts/machines/vmc3.yaml");
+  const CsvTable t = parseCsv(r.out.inputs_csv, "inputs");
+  const int ct = t.column("time_s"), cT = t.column("T_screws_C"), cf = t.column("feed_mm_per_min");
+  ASSERT_GE(cf, 0);
+  // First the rapid from the start (gauge X 0 Z 550) to X -300 Z 200 at 10 m/min per axis:
+  // 2.1 s (Z, 350 mm), path 460.98 mm, so 13.17 m/min and 131.7 W for 2.1 s; then 10 W.
+  const double G = 10, tau = 4000.0 / G, t1 = 350.0 / 10000.0 * 60.0;
+  const double Q1 = 10.0 * std::hypot(300.0, 350.0) / t1 * 60.0 / 1000.0, Q = 10.0;
+  const double dT1 = Q1 / G * (1 - std::exp(-t1 / tau));
+  int checked = 0;
+  for (const auto& row : t.rows) {
+    const double time = t.number(row, ct);
+    if (time <= t1 || time >= t1 + 720) continue;
+    const double dT = Q / G + (dT1 - Q / G) * std::exp(-(time - t1) / tau);
+    EXPECT_NEAR(t.number(row, cT), 20 + dT, 6e-4) << time;  // 3 decimals in the CSV
+    EXPECT_EQ(t.number(row, cf), 1000.0);
+    ++checked;
+  }
+  EXPECT_GE(checked, 10);
 }
 
 void expectRefusal(const std::string& prog, const std::string& want) {

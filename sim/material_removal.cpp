@@ -59,10 +59,19 @@ Interval capsule(const Vector2d& u, const Vector2d& v, const Vector2d& a, const 
 
 }  // namespace
 
-Stock::Stock(const Vector3d& min_mm, const Vector3d& max_mm, double cell_mm)
-    : min_(min_mm), max_(max_mm), cell_(cell_mm) {
-  nx_ = std::max(1, static_cast<int>(std::ceil((max_.x() - min_.x()) / cell_)));
-  ny_ = std::max(1, static_cast<int>(std::ceil((max_.y() - min_.y()) / cell_)));
+int Stock::cellX(double x) const {
+  return std::clamp(static_cast<int>(std::floor((x - min_.x()) / cx_)), 0, nx_ - 1);
+}
+int Stock::cellY(double y) const {
+  return std::clamp(static_cast<int>(std::floor((y - min_.y()) / cy_)), 0, ny_ - 1);
+}
+
+Stock::Stock(const Vector3d& min_mm, const Vector3d& max_mm, double cell_mm) : min_(min_mm), max_(max_mm) {
+  // Cells at most cell_mm, fitting the box exactly (no phantom material past its faces).
+  nx_ = std::max(1, static_cast<int>(std::ceil((max_.x() - min_.x()) / cell_mm - 1e-9)));
+  ny_ = std::max(1, static_cast<int>(std::ceil((max_.y() - min_.y()) / cell_mm - 1e-9)));
+  cx_ = (max_.x() - min_.x()) / nx_;
+  cy_ = (max_.y() - min_.y()) / ny_;
   top_.assign(static_cast<std::size_t>(nx_) * ny_, max_.z());
 }
 
@@ -74,15 +83,12 @@ Removal Stock::removeHeightField(const Vector3d& p0, const Vector3d& p1, double 
   const bool plunge = L2 < 1e-18;
   const double lo_x = std::min(a.x(), b.x()) - r, hi_x = std::max(a.x(), b.x()) + r;
   const double lo_y = std::min(a.y(), b.y()) - r, hi_y = std::max(a.y(), b.y()) + r;
-  const int i0 = std::max(0, static_cast<int>(std::floor((lo_x - min_.x()) / cell_)));
-  const int i1 = std::min(nx_ - 1, static_cast<int>(std::floor((hi_x - min_.x()) / cell_)));
-  const int j0 = std::max(0, static_cast<int>(std::floor((lo_y - min_.y()) / cell_)));
-  const int j1 = std::min(ny_ - 1, static_cast<int>(std::floor((hi_y - min_.y()) / cell_)));
-  const double area = cell_ * cell_;
+  const int i0 = cellX(lo_x), i1 = cellX(hi_x), j0 = cellY(lo_y), j1 = cellY(hi_y);
+  const double area = cx_ * cy_;
   Vector3d moment = Vector3d::Zero();
   for (int j = j0; j <= j1; ++j)
     for (int i = i0; i <= i1; ++i) {
-      const Vector2d c(min_.x() + (i + 0.5) * cell_, min_.y() + (j + 0.5) * cell_);
+      const Vector2d c(min_.x() + (i + 0.5) * cx_, min_.y() + (j + 0.5) * cy_);
       const double t = plunge ? 0.0 : std::clamp((c - a).dot(ab) / L2, 0.0, 1.0);
       if ((c - (a + t * ab)).norm() > r) continue;
       const double zb = plunge ? std::min(p0.z(), p1.z()) : p0.z() + t * (p1.z() - p0.z());
@@ -94,7 +100,7 @@ Removal Stock::removeHeightField(const Vector3d& p0, const Vector3d& p1, double 
         out.volume_mm3 += v;
         moment += v * Vector3d(c.x(), c.y(), (top + from) / 2);
       }
-      top = zb;
+      top = zb <= min_.z() ? -kInf : zb;  // cut through: no material left in the column
     }
   if (out.volume_mm3 > 0) out.centroid = moment / out.volume_mm3;
   return out;
@@ -125,15 +131,12 @@ void Stock::recordCut(const Vector3d& p0, const Vector3d& p1, double r, double t
 double Stock::topUnder(const Vector2d& xy, double r) const {
   double best = -kInf;
   if (nx_ == 0) return best;
-  const double reach = r + cell_ * 0.7072;
-  const int i0 = std::max(0, static_cast<int>(std::floor((xy.x() - reach - min_.x()) / cell_)));
-  const int i1 = std::min(nx_ - 1, static_cast<int>(std::floor((xy.x() + reach - min_.x()) / cell_)));
-  const int j0 = std::max(0, static_cast<int>(std::floor((xy.y() - reach - min_.y()) / cell_)));
-  const int j1 = std::min(ny_ - 1, static_cast<int>(std::floor((xy.y() + reach - min_.y()) / cell_)));
+  if (xy.x() + r < min_.x() || xy.x() - r > max_.x() || xy.y() + r < min_.y() || xy.y() - r > max_.y()) return best;
+  const int i0 = cellX(xy.x() - r), i1 = cellX(xy.x() + r), j0 = cellY(xy.y() - r), j1 = cellY(xy.y() + r);
   for (int j = j0; j <= j1; ++j)
     for (int i = i0; i <= i1; ++i) {
-      const Vector2d c(min_.x() + (i + 0.5) * cell_, min_.y() + (j + 0.5) * cell_);
-      if ((c - xy).norm() <= reach) best = std::max(best, top_[static_cast<std::size_t>(j) * nx_ + i]);
+      const Vector2d c(min_.x() + (i + 0.5) * cx_, min_.y() + (j + 0.5) * cy_);
+      if ((c - xy).norm() <= r) best = std::max(best, top_[static_cast<std::size_t>(j) * nx_ + i]);
     }
   return best;
 }
@@ -157,7 +160,7 @@ std::optional<double> Stock::firstMaterial(const Vector3d& f, const Vector3d& d,
     if (i.lo > cur) break;
     cur = std::max(cur, i.hi);
   }
-  if (cur > box.hi) return std::nullopt;
+  if (cur >= box.hi) return std::nullopt;  // the removed region reaches the exit: no surface
   return cur;
 }
 

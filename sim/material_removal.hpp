@@ -39,7 +39,8 @@ class Stock {
   // The exact part: the swept volume of the real (displaced) tool path.
   void recordCut(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, double radius, double time_s);
 
-  // Highest material under a disk (centre xy, radius) per the height field; -inf if none.
+  // Highest material under a disk (cells whose centres lie within `radius` of xy) per the
+  // height field; -inf if none.
   double topUnder(const Eigen::Vector2d& xy, double radius) const;
   // First s in [0, max_s] where from + s dir enters material (exact surface); nullopt if none.
   std::optional<double> firstMaterial(const Eigen::Vector3d& from, const Eigen::Vector3d& dir, double max_s) const;
@@ -51,8 +52,10 @@ class Stock {
 
  private:
   Eigen::Vector3d min_ = Eigen::Vector3d::Zero(), max_ = Eigen::Vector3d::Zero();
-  double cell_ = 0.25;
+  double cx_ = 0.25, cy_ = 0.25;
   int nx_ = 0, ny_ = 0;
+  int cellX(double x) const;
+  int cellY(double y) const;
   std::vector<double> top_;
   std::vector<SweptCut> cuts_;
 };

@@ -63,8 +63,8 @@ void ThermalNetwork::advance(double dt, double T_env, const Eigen::VectorXd& hea
   Eigen::VectorXd z = V_.transpose() * T_.cwiseProduct(sqrt_c_);
   const Eigen::VectorXd b = V_.transpose() * w;
   for (int i = 0; i < z.size(); ++i) {
-    const double e = std::exp(-lambda_(i) * dt);
-    z(i) = e * z(i) + (1.0 - e) / lambda_(i) * b(i);
+    const double one_minus_e = -std::expm1(-lambda_(i) * dt);  // exact for small lambda dt
+    z(i) = (1.0 - one_minus_e) * z(i) + one_minus_e / lambda_(i) * b(i);
   }
   T_ = (V_ * z).cwiseQuotient(sqrt_c_);
 }

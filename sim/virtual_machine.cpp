@@ -91,7 +91,7 @@ class VirtualMachine : public gcode::MachineInterface {
             << " s (sensors with noise and offset)\n";
     inputs_ << "time_s";
     for (const auto& s : tr.thermal.sensors) inputs_ << "," << s.column;
-    inputs_ << ",c_rpm,spindle_rpm,mwf_on,tool_changes\n";
+    inputs_ << ",c_rpm,spindle_rpm,feed_mm_per_min,mwf_on,tool_changes\n";
     if (w_) stock_ = Stock(w_->stock_min_mm, w_->stock_max_mm);
     // At rest at the top of Z (the tool-change height region), X and Y at the C axis.
     pos_.xyz_mm = Vector3d(std::clamp(m_.c_axis_centre_mm.x(), m_.x.min_mm, m_.x.max_mm),
@@ -100,6 +100,7 @@ class VirtualMachine : public gcode::MachineInterface {
   }
 
   MachinePosition start() const override { return pos_; }
+  void atLine(int line) override { line_ = line; }
 
   // --- gcode::MachineInterface ---------------------------------------------------------
   void rapid(const MachinePosition& to) override {
@@ -110,7 +111,9 @@ class VirtualMachine : public gcode::MachineInterface {
     t = std::max(t, d.maxCoeff() / m_.rapid_feed_mm_per_min * 60.0);
     t = std::max(t, rotaryTime(to.c_deg - pos_.c_deg, m_.c));
     t = std::max(t, rotaryTime(to.b_deg - pos_.b_deg, m_.b));
-    advance(t);
+    const double t0 = t_;
+    move(t, t > 0 ? (to.xyz_mm - pos_.xyz_mm).norm() / t * 60.0 : 0.0);
+    traceRow("rapid", to, 0, t0);
     pos_ = to;
   }
 
@@ -124,11 +127,20 @@ class VirtualMachine : public gcode::MachineInterface {
     checkPath(to, spindle_rpm_ == 0 && isCutter() ? "feed move (G1/G2/G3) with the spindle stopped" : "feed move (G1/G2/G3)");
     const double len = (to.xyz_mm - pos_.xyz_mm).norm();
     const double rot = std::max(std::fabs(to.c_deg - pos_.c_deg), std::fabs(to.b_deg - pos_.b_deg));
-    advance((len > 0 ? len : rot) / F * 60.0);
+    const double t0 = t_;
+    move((len > 0 ? len : rot) / F * 60.0, len > 0 ? F : 0.0);
+    traceRow("feed", to, F, t0);
     pos_ = to;
   }
 
   gcode::ProbeOutcome probe(const MachinePosition& to, double F, gcode::ProbeMode mode) override {
+    const double t0 = t_;
+    const auto r = probeMove(to, F, mode);
+    traceRow(r.contact ? "probe_contact" : "probe_no_contact", to, F, t0);
+    return r;
+  }
+
+  gcode::ProbeOutcome probeMove(const MachinePosition& to, double F, gcode::ProbeMode mode) {
     checkTravel(to);
     checkFeed(F);
     if (to.c_deg != pos_.c_deg || to.b_deg != pos_.b_deg)
@@ -137,10 +149,13 @@ class VirtualMachine : public gcode::MachineInterface {
     const double len = (g1 - g0).norm();
     if (len <= 0) throw InputError("", 0, "a probe move of zero length");
     const Vector3d dir = (g1 - g0) / len;
-    if (!a_) return probeWorkpiece(to, F, dir, len);
+    if (!a_) return probeWorkpiece(to, F, dir, len, mode);
     const Vector3d a = tipActual(g0), b = tipActual(g1);
     const Artifact art = artifact();
     // Stem and table first: a probe move may touch the sphere only.
+    // LinuxCNC refuses to start a probe move with the probe tripped; Fanuc skips at once.
+    if ((a - art.centre).norm() <= art.radius + tipRadius() && mode != gcode::ProbeMode::SkipToTarget)
+      throw SafetyError("probe move starts with the probe already in contact (tripped)");
     const double s_contact = firstSphereContact(a, b, art);
     const double s_end = s_contact >= 0 ? s_contact : 1.0;
     checkStemAndTable(a, a + s_end * (b - a), art, "probe move");
@@ -150,13 +165,12 @@ class VirtualMachine : public gcode::MachineInterface {
     const double s_trig = s_contact >= 0 ? s_contact + extra_mm / len : 2.0;
     if (s_contact < 0 || s_trig > 1.0) {
       // No trigger within the move: G38.2/G38.3 and G31 all end at the target.
-      advance(len / F * 60.0);
+      move(len / F * 60.0, F);
       pos_ = to;
       out.contact = false;
       out.stop = to;
       return out;
     }
-    (void)mode;
     ProbeEvent ev;
     ev.c_deg = pos_.c_deg;
     ev.approach = dir;
@@ -174,7 +188,7 @@ class VirtualMachine : public gcode::MachineInterface {
       const double q[3] = {m_.x.resolution_mm, m_.y.resolution_mm, m_.z.resolution_mm};
       for (int k = 0; k < 3; ++k) latched(k) = std::round(latched(k) / q[k]) * q[k];
     }
-    advance(travel_mm / F * 60.0);
+    move(travel_mm / F * 60.0, F);
     ev.time_s = t_;
     ev.reported_tip_mm = latched - Vector3d(0, 0, currentToolLength());
     events_.push_back(ev);
@@ -187,9 +201,11 @@ class VirtualMachine : public gcode::MachineInterface {
   }
 
   void dwell(double s) override {
+    const double t0 = t_;
     dwelling_ = true;
     advance(s);
     dwelling_ = false;
+    traceRow("dwell", pos_, 0, t0);
   }
 
   void toolChange(int tool) override {
@@ -200,9 +216,11 @@ class VirtualMachine : public gcode::MachineInterface {
                               " and the empty spindle T" + std::to_string(m_.tool_change.empty_tool) +
                               ", plus the workpiece's tools)");
     if (spindle_rpm_ != 0) throw SafetyError("tool change with the spindle turning (M5 first)");
+    const double t0 = t_;
     advance(m_.tool_change.time_s);
     ++tool_changes_;
     tool_ = tool;
+    traceRow("tool_change", pos_, 0, t0);
     atc_um_.setZero();
     if (probe && tr_.atc_repeatability_um > 0)
       for (int k = 0; k < 3; ++k) atc_um_(k) = tr_.atc_repeatability_um * normal_(atc_rng_);
@@ -263,6 +281,7 @@ class VirtualMachine : public gcode::MachineInterface {
   int tool_ = 0;
   Vector3d atc_um_ = Vector3d::Zero();
   double spindle_rpm_ = 0;
+  double path_speed_mm_per_min_ = 0;
   bool coolant_ = false, dwelling_ = false;
   int tool_changes_ = 0;
   std::vector<double> duty_levels_;  // random C levels per hold period, drawn as needed
@@ -270,6 +289,9 @@ class VirtualMachine : public gcode::MachineInterface {
   long log_lines_ = 0, pending_ = -1;
   std::string log_name_;
   std::vector<ProbeEvent> events_;
+  int line_ = 0;
+  bool trace_on_ = false;
+  std::ostringstream trace_;
 
   struct Artifact {
     Vector3d centre;      // actual sphere centre (tip coordinates)
@@ -318,12 +340,30 @@ class VirtualMachine : public gcode::MachineInterface {
       switch (s.input) {
         case HeatInput::CAxisRpm: v = std::fabs(cRpm(t)) * s.gain; break;
         case HeatInput::SpindleRpm: v = std::fabs(spindle_rpm_) * s.gain; break;
+        case HeatInput::AxisSpeed: v = path_speed_mm_per_min_ / 1000.0 * s.gain; break;
         case HeatInput::Mwf: v = mwfOn(t) ? s.gain : 0.0; break;
         case HeatInput::Constant: v = s.gain; break;
       }
       q(s.node) += v;
     }
     return q;
+  }
+
+  // One row of the motion trace: what the controller commanded, when, from which line.
+  void traceRow(const char* kind, const MachinePosition& to, double feed, double t_start) {
+    if (!trace_on_) return;
+    trace_ << formatNumber(t_start, 3) << "," << formatNumber(t_ - t_start, 3) << "," << line_ << "," << kind << ","
+           << formatNumber(to.xyz_mm.x(), 6) << "," << formatNumber(to.xyz_mm.y(), 6) << ","
+           << formatNumber(to.xyz_mm.z(), 6) << "," << formatNumber(to.b_deg, 6) << "," << formatNumber(to.c_deg, 6)
+           << "," << formatNumber(feed, 3) << "," << tool_ << "\n";
+  }
+
+  // Time passes while X/Y/Z move at this path speed (a heat input, and a column of the
+  // inputs CSV).
+  void move(double dt, double speed_mm_per_min) {
+    path_speed_mm_per_min_ = speed_mm_per_min;
+    advance(dt);
+    path_speed_mm_per_min_ = 0;
   }
 
   void advance(double dt) {
@@ -348,6 +388,7 @@ class VirtualMachine : public gcode::MachineInterface {
       inputs_ << "," << formatNumber(noisy, 3);
     }
     inputs_ << "," << formatNumber(cRpm(t_), 3) << "," << formatNumber(spindle_rpm_, 3) << ","
+            << formatNumber(path_speed_mm_per_min_, 3) << ","
             << (mwfOn(t_) ? 1 : 0) << "," << tool_changes_ << "\n";
     tool_changes_ = 0;
     last_sample_t_ = t_;
@@ -416,7 +457,7 @@ class VirtualMachine : public gcode::MachineInterface {
   Artifact artifact() const {
     Artifact art;
     art.dT = nodeRise(tr_.artifact.node);
-    const double grow = 1.0 + tr_.artifact.alpha_per_K * art.dT;
+    const double grow = 1.0 + partAlpha() * art.dT;
     const double sense = m_.c.positive_is_clockwise ? -1.0 : 1.0;
     const double th = degToRad(a_->angle_at_c0_deg + sense * pos_.c_deg);
     const double rot = degToRad(sense * pos_.c_deg);
@@ -496,15 +537,16 @@ class VirtualMachine : public gcode::MachineInterface {
     const parts::LinearAxis* ax[] = {&m_.x, &m_.y, &m_.z};
     const char* names[] = {"X", "Y", "Z"};
     for (int k = 0; k < 3; ++k)
-      if (to.xyz_mm(k) < ax[k]->min_mm - 1e-9 || to.xyz_mm(k) > ax[k]->max_mm + 1e-9)
+      if (!(to.xyz_mm(k) >= ax[k]->min_mm - 1e-9 && to.xyz_mm(k) <= ax[k]->max_mm + 1e-9))
         throw SafetyError(std::string("move outside travel: ") + names[k] + " " + formatNumber(to.xyz_mm(k)) +
                           " mm (gauge line, machine coordinates) is outside [" + formatNumber(ax[k]->min_mm) +
                           ", " + formatNumber(ax[k]->max_mm) + "]");
     if (to.b_deg != 0 && !m_.b.present) throw SafetyError("move of B on a machine without a B axis");
-    if (m_.b.present && (to.b_deg < m_.b.min_deg - 1e-9 || to.b_deg > m_.b.max_deg + 1e-9))
+    if (!std::isfinite(to.b_deg) || !std::isfinite(to.c_deg)) throw SafetyError("a rotary target that is not a number");
+    if (m_.b.present && !m_.b.continuous && !(to.b_deg >= m_.b.min_deg - 1e-9 && to.b_deg <= m_.b.max_deg + 1e-9))
       throw SafetyError("move outside travel: B " + formatNumber(to.b_deg) + " deg");
     if (to.c_deg != 0 && !m_.c.present) throw SafetyError("move of C on a machine without a C axis");
-    if (m_.c.present && !m_.c.continuous && (to.c_deg < m_.c.min_deg - 1e-9 || to.c_deg > m_.c.max_deg + 1e-9))
+    if (m_.c.present && !m_.c.continuous && !(to.c_deg >= m_.c.min_deg - 1e-9 && to.c_deg <= m_.c.max_deg + 1e-9))
       throw SafetyError("move outside travel: C " + formatNumber(to.c_deg) + " deg");
   }
 
@@ -522,14 +564,27 @@ class VirtualMachine : public gcode::MachineInterface {
   // the table's location errors (two fixed-point steps), turn back to C = 0, undo the
   // workpiece's expansion about its datum.
   Vector3d toWorkpiece(const Vector3d& q) const {
-    const auto e = geometry::LocationErrors::fromValues(locationErrors());
-    Vector3d p = q;
-    for (int k = 0; k < 2; ++k) p = q - (geometry::displacedOnTable(p, m_.c_axis_centre_mm, e) - p);
+    // The table's location errors as a rigid motion about the C axis at the table surface
+    // (a clamped workpiece moves with the table as one body; ER0T, a radial growth of the
+    // table, does not move it).
+    const auto e = locationErrors();
+    const Vector3d pivot(m_.c_axis_centre_mm.x(), m_.c_axis_centre_mm.y(), m_.table_surface_z_mm);
+    const Eigen::Matrix3d R = (Eigen::AngleAxisd(e[4] * 1e-6, Vector3d::UnitX()) *
+                               Eigen::AngleAxisd(e[5] * 1e-6, Vector3d::UnitY()) *
+                               Eigen::AngleAxisd(-e[6] * 1e-6, Vector3d::UnitZ())).toRotationMatrix();
+    const Vector3d t(e[0] * 1e-3, e[1] * 1e-3, e[2] * 1e-3);
+    Vector3d p = pivot + R.transpose() * (q - t - pivot);
     const double sense = m_.c.positive_is_clockwise ? -1.0 : 1.0;
     const double a = -degToRad(sense * pos_.c_deg);
     const Eigen::Vector2d c = m_.c_axis_centre_mm, d = p.head<2>() - c;
     p.head<2>() = c + Eigen::Vector2d(std::cos(a) * d.x() - std::sin(a) * d.y(), std::sin(a) * d.x() + std::cos(a) * d.y());
-    return w_->datum() + (p - w_->datum()) / (1.0 + tr_.artifact.alpha_per_K * workpieceAbove20K());
+    p -= tr_.artifact.placement_error_mm;  // where the part really sits on the table
+    return w_->datum() + (p - w_->datum()) / (1.0 + partAlpha() * workpieceAbove20K());
+  }
+  // The part's expansion coefficient: the truth's when it states one, else the material's.
+  double partAlpha() const {
+    if (tr_.artifact.alpha_per_K) return *tr_.artifact.alpha_per_K;
+    return w_ ? w_->material.alpha_per_K : 0.0;
   }
   // The workpiece's temperature above 20 °C, where the CMM measures it.
   double workpieceAbove20K() const {
@@ -569,7 +624,7 @@ class VirtualMachine : public gcode::MachineInterface {
     }
     if (to.c_deg != pos_.c_deg) {
       const Vector3d w = toWorkpiece(tipActual(pos_.xyz_mm));
-      if (w.z() - tipRadius() < stock_.max().z() + 1e-9)
+      if (w.z() - (tool_ == m_.probe.tool ? tipRadius() : 0.0) < stock_.max().z() + 1e-9)
         throw SafetyError(what + " turns the table with the tool below the top of the stock");
     }
   }
@@ -621,7 +676,7 @@ class VirtualMachine : public gcode::MachineInterface {
       }
     }
     // The cut is made warm; in the 20 °C frame the tool's radius shrinks with the part.
-    const double r_w = r / (1.0 + tr_.artifact.alpha_per_K * workpieceAbove20K());
+    const double r_w = r / (1.0 + partAlpha() * workpieceAbove20K());
     stock_.recordCut(w0 + defl, w1 + defl, r_w, t_);
     cuts_.push_back({{"time_s", t_}, {"tool", tool_},
                      {"p0_mm", {w0.x() + defl.x(), w0.y() + defl.y(), w0.z()}},
@@ -629,20 +684,32 @@ class VirtualMachine : public gcode::MachineInterface {
                      {"radius_mm", r_w}, {"removed_mm3", rem.volume_mm3}, {"Ft_N", Ft}, {"Fn_N", Fn},
                      {"deflection_um", {defl.x() * 1e3, defl.y() * 1e3}},
                      {"tool_drift_um", {toolDriftUm().x(), toolDriftUm().y(), toolDriftUm().z()}}});
-    advance(dt);
+    const double t0 = t_;
+    move(dt, F);
+    traceRow("cut", to, F, t0);
     pos_ = to;
   }
 
-  gcode::ProbeOutcome probeWorkpiece(const MachinePosition& to, double F, const Vector3d& dir, double len) {
+  gcode::ProbeOutcome probeWorkpiece(const MachinePosition& to, double F, const Vector3d& dir, double len,
+                                     gcode::ProbeMode mode) {
     gcode::ProbeOutcome out;
     double s_contact = -1;
     if (w_) {
       const double r = tipRadius();
       const Vector3d a = toWorkpiece(tipActual(pos_.xyz_mm)), b = toWorkpiece(tipActual(to.xyz_mm));
       const Vector3d d = (b - a).normalized();
+      // Distances in the workpiece frame (20 °C) -> machine travel.
+      const double to_machine = len / (b - a).norm();
       // The ball touches a surface square to the approach when its centre is r from it.
-      if (const auto s = stock_.firstMaterial(a, d, (b - a).norm() + r)) s_contact = std::max(0.0, *s - r);
-      if (s_contact > (b - a).norm()) s_contact = -1;
+      if (const auto s = stock_.firstMaterial(a, d, (b - a).norm() + r / to_machine)) {
+        s_contact = *s * to_machine - r;
+        if (s_contact < 0) {
+          if (mode != gcode::ProbeMode::SkipToTarget)
+            throw SafetyError("probe move starts with the probe already in contact (tripped)");
+          s_contact = 0;
+        }
+      }
+      if (s_contact > len) s_contact = -1;
       // Nothing else in the way before the contact (height field).
       MachinePosition until = to;
       if (s_contact >= 0) until.xyz_mm = pos_.xyz_mm + dir * std::max(0.0, s_contact - 0.01);
@@ -651,7 +718,7 @@ class VirtualMachine : public gcode::MachineInterface {
     const double pre_um = pretravel(dir);
     const double s_trig = s_contact >= 0 ? s_contact + pre_um * 1e-3 + F / 60.0 * tr_.probe.trigger_delay_s : 2 * len;
     if (s_contact < 0 || s_trig > len) {
-      advance(len / F * 60.0);
+      move(len / F * 60.0, F);
       pos_ = to;
       out.stop = to;
       return out;
@@ -670,6 +737,11 @@ class VirtualMachine : public gcode::MachineInterface {
 
  public:
   const Stock& stock() const { return stock_; }
+  void enableTrace() {
+    trace_on_ = true;
+    trace_ << "time_s,duration_s,line,kind,x_mm,y_mm,z_mm,b_deg,c_deg,feed_mm_per_min,tool\n";
+  }
+  std::string traceText() const { return trace_.str(); }
   std::string cutsJson() const { return cuts_.dump(1) + "\n"; }
 
  private:
@@ -681,7 +753,7 @@ class VirtualMachine : public gcode::MachineInterface {
     // What a sphere campaign evaluation sees: table errors minus the tool's translation,
     // plus the artifact's own growth (radius from the axis and height).
     ev.apparent = art.location;
-    const double a = tr_.artifact.alpha_per_K * art.dT;
+    const double a = partAlpha() * art.dT;
     ev.apparent[0] -= ev.tool_um.x();
     ev.apparent[1] -= ev.tool_um.y();
     ev.apparent[2] -= ev.tool_um.z();
@@ -699,6 +771,8 @@ SimulationOutputs simulateProgram(const std::string& program_file, const std::st
                                   const MachineTruth& truth, std::uint64_t seed) {
   if (part.artifact && !machine.c.present)
     throw InputError(machine.file, 0, "the sphere artifact stands on a rotary table, and this machine has no C axis");
+  if (part.artifact && truth.artifact.node >= 0 && !truth.artifact.alpha_per_K)
+    throw InputError(truth.file, 0, "artifact.alpha_um_per_m_K: a sphere artifact on a thermal node needs its expansion coefficient");
   if ((part.artifact != nullptr) == (part.workpiece != nullptr))
     throw InputError("", 0, "simulate needs exactly one part on the table: a sphere artifact or a workpiece");
   if (!part.cmm_points.empty() && !part.workpiece)
@@ -710,6 +784,7 @@ SimulationOutputs simulateProgram(const std::string& program_file, const std::st
   if (ext == ".nc" || ext == ".tap") dialect = gcode::ProgramDialect::FanucMacroB;
   gcode::Interpreter interp(dialect, program_file, text);
   VirtualMachine vm(machine, part, truth, seed);
+  if (part.trace) vm.enableTrace();
   const auto run = interp.run(vm);
   vm.finish();
 
@@ -717,10 +792,11 @@ SimulationOutputs simulateProgram(const std::string& program_file, const std::st
   out.blocks = run.blocks_executed;
   out.end_time_s = vm.time();
   out.log_text = vm.logText();
+  out.trace_csv = vm.traceText();
   if (part.workpiece) {
     out.cuts_json = vm.cutsJson();
     if (!part.cmm_points.empty())
-      out.cmm_csv = measureOnCmm(vm.stock(), *part.workpiece, part.cmm_points, "cmm points", seed);
+      out.cmm_csv = measureOnCmm(vm.stock(), *part.workpiece, part.cmm_points, part.cmm_points_file, seed);
   }
 
   if (dialect == gcode::ProgramDialect::FanucMacroB) out.log_name = "dprnt.txt";

@@ -38,6 +38,7 @@ struct SimulationOutputs {
   std::string truth_json;  // injected error values per probe event and per cycle
   std::string cuts_json;   // workpiece: the surfaces actually cut (swept volumes), forces
   std::string cmm_csv;     // workpiece with CMM points: the CMM export
+  std::string trace_csv;   // with SimulationPart::trace: every motion, dwell and tool change
   double end_time_s = 0;
   long probe_events = 0;
   long blocks = 0;
@@ -48,6 +49,8 @@ struct SimulationPart {
   const parts::SphereArtifact* artifact = nullptr;
   const parts::Workpiece* workpiece = nullptr;
   std::vector<CmmPoint> cmm_points;  // workpiece: measured on the CMM after the program
+  std::string cmm_points_file = "CMM points";  // for error messages
+  bool trace = false;                // also write the motion trace
 };
 
 SimulationOutputs simulateProgram(const std::string& program_file, const std::string& program_text,

@@ -122,7 +122,11 @@ check "simulated points CSV and DPRNT log agree (1 um quantised)" cmp <(cut -d, 
 check "simulate runs the LinuxCNC program" "$PL" simulate "$LCNC_PLAN/sphere_cycle.ngc" --machine "$LCNC" --part "$W/art2.yaml" --truth "$CAMP" --out "$W/vl" --seed 3
 "$PL" evaluate "$W/vl/sphere_probe.log" --manifest "$LCNC_PLAN/plan.json" --out "$W/vl/e" > /dev/null
 check "simulated LinuxCNC campaign: truth recovered within U (coverage)" python3 "$SRC/tests/integration/compare_errors.py" "$W/vl/e/errors.csv" "$W/vl/truth.json" 0 0 --coverage
-check "inputs CSV has the sensors and machine state" grep -q '^time_s,T_env_C,T_caxis_C,T_table_C,c_rpm,spindle_rpm,mwf_on,tool_changes$' "$W/v/inputs.csv"
+"$PL" simulate "$LCNC_PLAN/sphere_cycle.ngc" --machine "$LCNC" --part "$W/art2.yaml" --truth "$CAMP" --out "$W/vt" --trace > /dev/null
+if [ -s "$W/lc/canon.txt" ]; then
+  check "our interpreter commands the moves LinuxCNC's rs274 commands" python3 "$SRC/tests/integration/compare_trace_rs274.py" "$W/lc/canon.txt" "$W/vt/trace.csv"
+fi
+check "inputs CSV has the sensors and machine state" grep -q '^time_s,T_env_C,T_caxis_C,T_table_C,c_rpm,spindle_rpm,feed_mm_per_min,mwf_on,tool_changes$' "$W/v/inputs.csv"
 "$PL" simulate "$FA_PLAN/sphere_cycle.nc" --machine "$NMV" --part "$ART" --truth "$CAMP" --out "$W/v2" --seed 3 > /dev/null
 check "simulate: same seed, byte-identical outputs" bash -c "cmp '$W/v/dprnt.txt' '$W/v2/dprnt.txt' && cmp '$W/v/inputs.csv' '$W/v2/inputs.csv' && cmp '$W/v/truth.json' '$W/v2/truth.json' && cmp '$W/v/points.csv' '$W/v2/points.csv'"
 # A hidden rigid truth, no noise: the simulated campaign recovers it like the generator does.
