@@ -159,24 +159,29 @@ class VirtualMachine : public gcode::MachineInterface {
     const double s_contact = firstSphereContact(a, b, art);
     const double s_end = s_contact >= 0 ? s_contact : 1.0;
     checkStemAndTable(a, a + s_end * (b - a), art, "probe move");
-    gcode::ProbeOutcome out;
     const double pre_um = pretravel(dir);
     const double extra_mm = pre_um * 1e-3 + F / 60.0 * tr_.probe.trigger_delay_s;
     const double s_trig = s_contact >= 0 ? s_contact + extra_mm / len : 2.0;
-    if (s_contact < 0 || s_trig > 1.0) {
-      // No trigger within the move: G38.2/G38.3 and G31 all end at the target.
-      move(len / F * 60.0, F);
-      pos_ = to;
-      out.contact = false;
-      out.stop = to;
-      return out;
-    }
+    if (s_contact < 0 || s_trig > 1.0) return noTrigger(to, len, F);
+    ProbeEvent ev = newEvent(dir, pre_um);
+    fillTruth(ev, art);
+    return latchTrigger(ev, dir, s_trig * len, F);
+  }
+
+  // No trigger within the move: G38.2/G38.3 and G31 all end at the target.
+  gcode::ProbeOutcome noTrigger(const MachinePosition& to, double len, double F) {
+    move(len / F * 60.0, F);
+    pos_ = to;
+    gcode::ProbeOutcome out;
+    out.stop = to;
+    return out;
+  }
+  ProbeEvent newEvent(const Vector3d& dir, double pretravel_um) const {
     ProbeEvent ev;
     ev.c_deg = pos_.c_deg;
     ev.approach = dir;
-    ev.pretravel_um = pre_um;
-    fillTruth(ev, art);
-    return latchTrigger(ev, dir, s_trig * len, F);
+    ev.pretravel_um = pretravel_um;
+    return ev;
   }
 
   // The controller latches the trigger: repeatability noise along the approach, the axes'
@@ -692,7 +697,6 @@ class VirtualMachine : public gcode::MachineInterface {
 
   gcode::ProbeOutcome probeWorkpiece(const MachinePosition& to, double F, const Vector3d& dir, double len,
                                      gcode::ProbeMode mode) {
-    gcode::ProbeOutcome out;
     double s_contact = -1;
     if (w_) {
       const double r = tipRadius();
@@ -717,16 +721,8 @@ class VirtualMachine : public gcode::MachineInterface {
     }
     const double pre_um = pretravel(dir);
     const double s_trig = s_contact >= 0 ? s_contact + pre_um * 1e-3 + F / 60.0 * tr_.probe.trigger_delay_s : 2 * len;
-    if (s_contact < 0 || s_trig > len) {
-      move(len / F * 60.0, F);
-      pos_ = to;
-      out.stop = to;
-      return out;
-    }
-    ProbeEvent ev;
-    ev.c_deg = pos_.c_deg;
-    ev.approach = dir;
-    ev.pretravel_um = pre_um;
+    if (s_contact < 0 || s_trig > len) return noTrigger(to, len, F);
+    ProbeEvent ev = newEvent(dir, pre_um);
     ev.location = locationErrors();
     ev.tool_um = toolDriftUm();
     ev.atc_um = atc_um_;
