@@ -178,6 +178,15 @@ assert 37.98 < z < 38.0, z
 assert 35.0 < x < 35.02, x
 print("top z", z, "wall x", x)
 PY
+# The shipped machining program passes rs274, and our interpreter commands the same moves.
+printf 'T1 P1 Z6.299212598 D0.393700787 ;end mill 160 mm\nT99 P99 Z5.905511811 D0.236220472 ;probe\n' > "$W/mill.tbl"
+if command -v rs274 >/dev/null; then
+  rs274 -t "$W/mill.tbl" -g "$SRC/examples/block_face_and_wall.ngc" > "$W/m/canon.txt" 2>&1
+  check "rs274 runs the machining example to its end" grep -q 'PROGRAM_END' "$W/m/canon.txt"
+  "$PL" simulate "$SRC/examples/block_face_and_wall.ngc" --machine "$VMC" --part "$SRC/examples/workpiece_block.yaml" \
+    --truth "$SRC/examples/truth_machining.yaml" --out "$W/mt" --trace > /dev/null
+  check "machining: our interpreter commands the moves rs274 commands" python3 "$SRC/tests/integration/compare_trace_rs274.py" "$W/m/canon.txt" "$W/mt/trace.csv"
+fi
 sed 's/^G1 Y-30 F600/G0 Y-30/' "$SRC/examples/block_face_and_wall.ngc" > "$W/rapidcut.ngc"
 line=$(grep -n '^G0 Y-30' "$W/rapidcut.ngc" | cut -d: -f1)
 refuses "a rapid through the stock names its line" "rapidcut.ngc:$line: rapid \(G0\) would move through the workpiece's material" \
