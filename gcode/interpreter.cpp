@@ -494,6 +494,7 @@ class Execution {
     if (o.keyword == "WHILE") {
       if (!condition(c)) next = jump_.at(k) + 1;
     } else if (o.keyword == "ENDIF") {
+      // Reached by falling out of the last branch or by a jump: nothing to do.
     } else if (o.keyword == "ENDWHILE") {
       next = loop_back_.at(k);
     } else if (o.keyword == "IF") {
@@ -513,7 +514,6 @@ class Execution {
       }
       next = endif_of_.at(k);
     }
-    (void)code;
   }
   static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
   std::size_t branch_target_ = kNone;

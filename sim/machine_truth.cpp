@@ -55,8 +55,6 @@ ErrorVector readErrorVector(YamlMap& m, const std::string& suffix) {
   return e;
 }
 
-// Bare numbers: coefficients as written (um/mm^k or urad/mm^k).
-std::vector<double> numberList(YamlMap& m, const std::string& key, Dimension d) { return m.quantityList(key, d); }
 
 void loadThermal(YamlMap t, ThermalTruth& th) {
   th.present = true;
@@ -185,7 +183,8 @@ MachineTruth loadMachineTruth(const std::string& path) {
       for (int e = 0; e < 6; ++e) {
         const std::string key = std::string(err[e]) + axn[i] + (e < 3 ? "_um" : "_urad");
         if (m->has(key)) {
-          t.axes.coeff[i][e] = numberList(*m, key, e < 3 ? Dimension::Micrometre : Dimension::Microradian);
+          // Bare numbers: coefficients as written (um/mm^k or urad/mm^k).
+          t.axes.coeff[i][e] = m->quantityList(key, e < 3 ? Dimension::Micrometre : Dimension::Microradian);
           t.axes.any = true;
         } else {
           m->numberOr(key, 0);  // allowed key

@@ -45,8 +45,6 @@ class Stock {
   // First s in [0, max_s] where from + s dir enters material (exact surface); nullopt if none.
   std::optional<double> firstMaterial(const Eigen::Vector3d& from, const Eigen::Vector3d& dir, double max_s) const;
 
-  const std::vector<SweptCut>& cuts() const { return cuts_; }
-  bool empty() const { return nx_ == 0; }
   const Eigen::Vector3d& min() const { return min_; }
   const Eigen::Vector3d& max() const { return max_; }
 

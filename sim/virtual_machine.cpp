@@ -509,9 +509,9 @@ class VirtualMachine : public gcode::MachineInterface {
   void checkPath(const MachinePosition& to, const std::string& what) const {
     if (w_) return checkWorkpiecePath(to, what);
     if (!a_) return;
+    const Artifact art = artifact();
     if (to.c_deg != pos_.c_deg || to.b_deg != pos_.b_deg) {
       // The table turns under a still tip: it must be clear of the sphere's circle.
-      const Artifact art = artifact();
       const Vector3d tip = tipActual(pos_.xyz_mm);
       if (tip.z() - tipRadius() < art.centre.z() + art.radius + 1e-9) {
         const double r_tip = std::hypot(tip.x() - m_.c_axis_centre_mm.x(), tip.y() - m_.c_axis_centre_mm.y());
@@ -521,7 +521,6 @@ class VirtualMachine : public gcode::MachineInterface {
       }
       if (to.xyz_mm == pos_.xyz_mm) return;
     }
-    const Artifact art = artifact();
     const Vector3d a = tipActual(pos_.xyz_mm), b = tipActual(to.xyz_mm);
     const double Rt = art.radius + tipRadius();
     // After a trigger the stylus is deflected into the surface by pre-travel, delay and
@@ -683,12 +682,13 @@ class VirtualMachine : public gcode::MachineInterface {
     // The cut is made warm; in the 20 °C frame the tool's radius shrinks with the part.
     const double r_w = r / (1.0 + partAlpha() * workpieceAbove20K());
     stock_.recordCut(w0 + defl, w1 + defl, r_w, t_);
+    const Vector3d drift = toolDriftUm();
     cuts_.push_back({{"time_s", t_}, {"tool", tool_},
                      {"p0_mm", {w0.x() + defl.x(), w0.y() + defl.y(), w0.z()}},
                      {"p1_mm", {w1.x() + defl.x(), w1.y() + defl.y(), w1.z()}},
                      {"radius_mm", r_w}, {"removed_mm3", rem.volume_mm3}, {"Ft_N", Ft}, {"Fn_N", Fn},
                      {"deflection_um", {defl.x() * 1e3, defl.y() * 1e3}},
-                     {"tool_drift_um", {toolDriftUm().x(), toolDriftUm().y(), toolDriftUm().z()}}});
+                     {"tool_drift_um", {drift.x(), drift.y(), drift.z()}}});
     const double t0 = t_;
     move(dt, F);
     traceRow("cut", to, F, t0);
