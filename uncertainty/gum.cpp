@@ -112,6 +112,21 @@ Validation validate(const GufResult& g, const McmResult& m, int nd) {
   return v;
 }
 
+double outputCorrelation(const Problem& p, const GufResult& a, const GufResult& b) {
+  const auto n = static_cast<Eigen::Index>(p.inputs.size());
+  if (static_cast<Eigen::Index>(a.c.size()) != n || static_cast<Eigen::Index>(b.c.size()) != n)
+    throw std::invalid_argument("outputCorrelation: both results must come from this problem's inputs");
+  Eigen::VectorXd ca(n), cb(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const double u = p.inputs[static_cast<std::size_t>(i)].gufU();
+    ca(i) = a.c[static_cast<std::size_t>(i)] * u;
+    cb(i) = b.c[static_cast<std::size_t>(i)] * u;
+  }
+  const double cov = p.correlation.size() ? ca.dot(p.correlation * cb) : ca.dot(cb);
+  if (!(a.u_c > 0 && b.u_c > 0)) return 0.0;
+  return cov / (a.u_c * b.u_c);
+}
+
 namespace detail {
 
 void undefinedAtEstimate(const std::string& output) {

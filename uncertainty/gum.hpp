@@ -44,6 +44,10 @@ struct Input {
   char type = 'B';
   double half_width = 0;  // rectangular, triangular, U-shaped
   double scale = 0;       // Student t: x = value + scale * t_dof
+  // The standard uncertainty the GUF propagates: s(x) with its dof for a Student t input
+  // (JCGM 100 4.2, G.3), u otherwise. (u itself is the standard deviation of the PDF the MCM
+  // draws, JCGM 101 6.4.9.)
+  double gufU() const { return distribution == Distribution::StudentT ? scale : u; }
 
   static Input normal(std::string name, double value, double u, double dof = std::numeric_limits<double>::infinity());
   static Input rectangular(std::string name, double value, double half_width);  // u = a / sqrt 3
@@ -101,6 +105,10 @@ double numericalTolerance(double u, int significant_digits);
 
 Validation validate(const GufResult& g, const McmResult& m, int significant_digits = 2);
 
+// Correlation of two outputs of the same inputs (JCGM 100 H.2.4, F.1.2.3):
+// r(y_a, y_b) = c_a^T V c_b / (u(y_a) u(y_b)), V the input covariance.
+double outputCorrelation(const Problem& p, const GufResult& a, const GufResult& b);
+
 namespace detail {
 [[noreturn]] void undefinedAtEstimate(const std::string& output);
 std::vector<double> sampleInputs(const Problem& p, long trials, std::uint64_t seed, long offset);
@@ -126,7 +134,7 @@ GufResult propagate(const Problem& pr, const Model& f, double p = 0.95) {
   for (int i = 0; i < n; ++i) {
     const auto& in = pr.inputs[static_cast<std::size_t>(i)];
     r.c.push_back(y.v(i));
-    cu(i) = y.v(i) * in.u;
+    cu(i) = y.v(i) * in.gufU();
     Contribution c;
     c.input = in.name;
     c.type = in.type;
