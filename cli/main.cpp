@@ -6,6 +6,7 @@
 #include <iostream>
 #include <optional>
 #include <sstream>
+#include <unistd.h>
 
 #include "core/atomic_file.hpp"
 #include "core/csv.hpp"
@@ -14,6 +15,7 @@
 #include "evaluate/ingest.hpp"
 #include "evaluate/point_cloud.hpp"
 #include "evaluate/sphere_campaign.hpp"
+#include "parts/gum_model.hpp"
 #include "parts/machine.hpp"
 #include "parts/plan_manifest.hpp"
 #include "parts/sphere_artifact.hpp"
@@ -198,6 +200,27 @@ int cmdEvaluate(const std::string& points_file, const std::string& manifest_file
   return 0;
 }
 
+int cmdGum(const std::string& model_file, bool mcm, long trials, std::uint64_t seed, int digits,
+           const std::string& json_file) {
+  const auto model = parts::loadGumModel(model_file);
+  std::optional<uncertainty::McmOptions> mo;
+  if (mcm) {
+    uncertainty::McmOptions o;
+    o.fixed_trials = trials;
+    o.seed = seed;
+    o.significant_digits = digits;
+    if (isatty(STDERR_FILENO))  // a progress line on long runs, only for a person watching
+      o.progress = [](long done) { std::fprintf(stderr, "\rMonte Carlo: %ld trials", done); };
+    mo = o;
+  }
+  const auto r = uncertainty::evaluateTextModel(model, mo);
+  if (mo && mo->progress) std::fprintf(stderr, "\r%40s\r", "");
+  if (!json_file.empty()) writeFileAtomic(json_file, uncertainty::textModelJson(model, r));
+  std::fputs(uncertainty::textModelReport(model, r).c_str(), stdout);
+  if (!json_file.empty()) std::printf("\nWrote %s\n", json_file.c_str());
+  return 0;
+}
+
 struct FitArgs {
   std::string kind, points, method = "ls", format = "auto", feature, material, approach, out;
   double tip_radius_mm = 0.0;
@@ -317,6 +340,18 @@ int main(int argc, char** argv) {
   fit->add_flag("--json", fa.json, "print the JSON report instead of the text summary");
   fit->add_option("--out", fa.out, "also write the JSON report to this file");
 
+  std::string gum_model, gum_json;
+  bool gum_mcm = false;
+  long gum_trials = 0;
+  int gum_digits = 2;
+  auto* gum = app.add_subcommand("gum", "Uncertainty of a user measurement model (YAML): GUM budget, Monte Carlo, validation");
+  gum->add_option("model", gum_model, "measurement model (YAML, kind: gum_model)")->required()->check(CLI::ExistingFile);
+  gum->add_flag("--mcm", gum_mcm, "also run the Monte Carlo method (JCGM 101) and validate the GUF against it");
+  gum->add_option("--trials", gum_trials, "Monte Carlo trials (0: adaptive, JCGM 101 7.9)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  gum->add_option("--digits", gum_digits, "adaptive stop: significant digits of u (n_dig)")->capture_default_str()->check(CLI::Range(1, 4));
+  gum->add_option("--seed", seed, "random seed")->capture_default_str();
+  gum->add_option("--json", gum_json, "also write the results as JSON to this file");
+
   CLI11_PARSE(app, argc, argv);
   try {
     if (*plan) return cmdPlan(artifact, machine, out, dialect);
@@ -324,6 +359,7 @@ int main(int argc, char** argv) {
     if (*syn) return cmdSynth(manifest, truth, out, seed);
     if (*simc) return cmdSimulate(program, machine, part, truth, out, seed, cmm_points, sim_trace);
     if (*fit) return cmdFit(fa);
+    if (*gum) return cmdGum(gum_model, gum_mcm || gum_trials > 0, gum_trials, seed, gum_digits, gum_json);
     if (*ev) return cmdEvaluate(points, manifest, out, format, free_radius, scene, exaggeration);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "probeloop: error: %s\n", e.what());

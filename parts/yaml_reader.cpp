@@ -91,6 +91,31 @@ double YamlMap::number(const std::string& key) {
   return v;
 }
 
+std::vector<double> YamlMap::numberList(const std::string& key) {
+  const YAML::Node n = node(key);
+  if (!n.IsSequence() || n.size() == 0) fail(key, "expected a non-empty list of numbers");
+  std::vector<double> out;
+  for (const auto& item : n) {
+    double v = 0;
+    if (!item.IsScalar() || !parseFiniteNumber(item.Scalar(), v))
+      throw InputError(file_, item.Mark().line + 1,
+                       (path_.empty() ? key : path_ + "." + key) + "[" + std::to_string(out.size()) +
+                           "]: expected a finite number");
+    out.push_back(v);
+  }
+  return out;
+}
+
+int YamlMap::textColumn(const std::string& key) const {
+  const YAML::Node n = node_[key];
+  if (!n || !n.IsScalar()) return 0;
+  if (n.Scalar().find('\n') != std::string::npos) return 0;
+  // yaml-cpp tags quoted scalars "!" and plain ones "?"; the mark is at the quote.
+  return n.Mark().column + 1 + (n.Tag() == "!" ? 1 : 0);
+}
+
+YAML::Node YamlMap::raw(const std::string& key) { return node(key); }
+
 double YamlMap::numberOr(const std::string& key, double fallback) {
   allowed_.insert(key);
   return has(key) ? number(key) : fallback;

@@ -25,6 +25,7 @@ class YamlMap {
   std::vector<double> quantityList(const std::string& key, Dimension dim);
   double number(const std::string& key);  // a plain finite number (unit in the key's name)
   double numberOr(const std::string& key, double fallback);
+  std::vector<double> numberList(const std::string& key);  // a non-empty list of finite numbers
   int integer(const std::string& key);
   int integerOr(const std::string& key, int fallback);
   bool boolean(const std::string& key);
@@ -39,6 +40,10 @@ class YamlMap {
 
   int line() const;                       // 1-based line of this mapping
   int line(const std::string& key) const;  // 1-based line of a key's value
+  // 1-based file column where a single-line scalar's text starts (after an opening quote);
+  // 0 for block scalars, whose text starts on a later line.
+  int textColumn(const std::string& key) const;
+  YAML::Node raw(const std::string& key);  // the node itself (for shapes the accessors lack)
   [[noreturn]] void fail(const std::string& key, const std::string& message) const;
   const std::string& file() const { return file_; }
 

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <boost/math/distributions/normal.hpp>
 #include <boost/math/distributions/students_t.hpp>
+#include <iomanip>
 #include <random>
+#include <sstream>
 
 #include "core/error.hpp"
 
@@ -127,6 +129,63 @@ double outputCorrelation(const Problem& p, const GufResult& a, const GufResult& 
   return cov / (a.u_c * b.u_c);
 }
 
+GufResult gufFromGradient(const Problem& pr, double y, const std::vector<double>& dydx, double p) {
+  pr.check();
+  bool finite = std::isfinite(y);
+  for (double d : dydx) finite = finite && std::isfinite(d);
+  if (!finite) detail::undefinedAtEstimate(pr.output);
+  const auto n = static_cast<Eigen::Index>(pr.inputs.size());
+  GufResult r;
+  r.y = y;
+  r.p = p;
+  r.correlated = pr.correlation.size() > 0;
+  Eigen::VectorXd cu(n);
+  std::vector<Contribution> contributions;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    const auto& in = pr.inputs[static_cast<std::size_t>(i)];
+    const double c_i = dydx[static_cast<std::size_t>(i)];
+    r.c.push_back(c_i);
+    cu(i) = c_i * in.gufU();
+    Contribution c;
+    c.input = in.name;
+    c.type = in.type;
+    c.distribution = distributionName(in.distribution);
+    std::ostringstream basis;
+    basis << "c = " << std::setprecision(6) << c_i;
+    c.basis = basis.str();
+    c.u = std::fabs(cu(i));
+    c.dof = in.dof;
+    contributions.push_back(c);
+  }
+  const double u2 = r.correlated ? cu.dot(pr.correlation * cu) : cu.squaredNorm();
+  r.budget = combine(pr.output, pr.unit, r.y, contributions);
+  r.u_c = std::sqrt(std::max(0.0, u2));
+  r.budget.u_c = r.u_c;
+  double ws = 0;
+  for (const auto& c : r.budget.contributions)
+    if (std::isfinite(c.dof) && c.u > 0) ws += std::pow(c.u, 4) / c.dof;
+  r.nu_eff = ws > 0 ? std::pow(r.u_c, 4) / ws : std::numeric_limits<double>::infinity();  // G.2b
+  if (r.correlated) {
+    // With correlated inputs u_c can be smaller than single contributions and G.2b collapses
+    // (JCGM 100 H.2: nu_eff of R would be 0.12). The usual case is inputs observed together
+    // (n simultaneous observations), for which nu = n - 1 (Willink 2007): nu_eff is not
+    // allowed below the smallest dof of the correlated inputs that contribute.
+    double floor_dof = std::numeric_limits<double>::infinity();
+    for (Eigen::Index i = 0; i < n; ++i) {
+      bool correlated_i = false;
+      for (Eigen::Index j = 0; j < n; ++j) correlated_i = correlated_i || (i != j && pr.correlation(i, j) != 0);
+      if (correlated_i && cu(i) != 0) floor_dof = std::min(floor_dof, pr.inputs[static_cast<std::size_t>(i)].dof);
+    }
+    if (std::isfinite(floor_dof)) r.nu_eff = std::max(r.nu_eff, floor_dof);
+  }
+  r.budget.nu_eff = r.nu_eff;
+  r.k = coverageFactor(p, std::isfinite(r.nu_eff) ? std::max(1.0, std::floor(r.nu_eff)) : r.nu_eff);  // G.6.4
+  r.U = r.k * r.u_c;
+  r.budget.k = r.k;
+  r.budget.U = r.U;
+  return r;
+}
+
 namespace detail {
 
 void undefinedAtEstimate(const std::string& output) {
@@ -177,6 +236,30 @@ std::vector<double> sampleInputs(const Problem& p, long trials, std::uint64_t se
     }
   }
   return x;
+}
+
+long batchSize(const McmOptions& o) {
+  if (o.fixed_trials > 0) return std::min(o.fixed_trials, 100'000L);  // bounded memory per draw
+  return o.batch > 0 ? o.batch : std::max(10'000L, static_cast<long>(std::ceil(100.0 / (1.0 - o.p))));
+}
+
+bool stable(const std::vector<McmResult>& batches, int nd) {
+  if (batches.size() < 2) return false;
+  const double h = static_cast<double>(batches.size());
+  auto spread = [&](auto get) {
+    double m = 0, s = 0;
+    for (const auto& b : batches) m += get(b);
+    m /= h;
+    for (const auto& b : batches) s += (get(b) - m) * (get(b) - m);
+    return std::sqrt(s / (h - 1) / h);
+  };
+  double u_mean = 0;
+  for (const auto& b : batches) u_mean += b.u;
+  const double delta = numericalTolerance(u_mean / h, nd);
+  return 2 * spread([](const McmResult& b) { return b.y; }) <= delta &&
+         2 * spread([](const McmResult& b) { return b.u; }) <= delta &&
+         2 * spread([](const McmResult& b) { return b.symmetric_low; }) <= delta &&
+         2 * spread([](const McmResult& b) { return b.symmetric_high; }) <= delta;
 }
 
 McmResult summarise(std::vector<double>& y, double p) {

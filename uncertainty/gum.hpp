@@ -11,8 +11,8 @@
 //   and degrees of freedom; the correlation matrix (empty = none) must be symmetric with a
 //   unit diagonal and positive semidefinite: InputError otherwise.
 // - GUF: u_c^2 = c^T V c; nu_eff by Welch-Satterthwaite (JCGM 100 G.2b) over the
-//   contributions |c_i| u_i (with correlated inputs this is the usual approximation, and the
-//   result says so); k from Student's t at floor(nu_eff) (G.6.4) for the coverage p. A
+//   contributions |c_i| u_i (with correlated inputs an approximation, not allowed below the
+//   smallest dof of the correlated inputs that contribute; the result says so); k from Student's t at floor(nu_eff) (G.6.4) for the coverage p. A
 //   model whose value or derivative is not finite at the estimate is a GeometryError.
 // - MCM: deterministic for a seed; correlated inputs must be normal (JCGM 101 6.4.8);
 //   adaptive trials per JCGM 101 7.9 with n_dig significant digits; probabilistically
@@ -77,7 +77,7 @@ struct McmOptions {
   int significant_digits = 2;  // n_dig of JCGM 101 7.9
   long batch = 0;              // 0: max(ceil(100 / (1 - p)), 10^4)
   long max_trials = 100'000'000;
-  long fixed_trials = 0;       // > 0: exactly this many, no adaptive stop
+  long fixed_trials = 0;       // > 0: exactly this many (drawn in batches), no adaptive stop
   std::uint64_t seed = 1;
   std::function<void(long done)> progress;  // called after each batch
 };
@@ -113,7 +113,15 @@ namespace detail {
 [[noreturn]] void undefinedAtEstimate(const std::string& output);
 std::vector<double> sampleInputs(const Problem& p, long trials, std::uint64_t seed, long offset);
 McmResult summarise(std::vector<double>& y, double p);
+// JCGM 101 7.9.4: twice the standard deviation of the batch means of y, u and both interval
+// ends is within the numerical tolerance of u (needs >= 2 batches).
+bool stable(const std::vector<McmResult>& batches, int significant_digits);
+long batchSize(const McmOptions& o);
 }  // namespace detail
+
+// The GUF from a model's value and gradient at the estimate (models whose number of inputs
+// is known only at run time, e.g. Expression::gradient). Checks the problem.
+GufResult gufFromGradient(const Problem& pr, double y, const std::vector<double>& dydx, double p = 0.95);
 
 template <int N, class Model>
 GufResult propagate(const Problem& pr, const Model& f, double p = 0.95) {
@@ -125,76 +133,31 @@ GufResult propagate(const Problem& pr, const Model& f, double p = 0.95) {
   for (int i = 0; i < n; ++i) x[static_cast<std::size_t>(i)] = J(pr.inputs[static_cast<std::size_t>(i)].value, i);
   const J y = f(x.data());
   if (!std::isfinite(y.a) || !y.v.allFinite()) detail::undefinedAtEstimate(pr.output);
-  GufResult r;
-  r.y = y.a;
-  r.p = p;
-  r.correlated = pr.correlation.size() > 0;
-  Eigen::VectorXd cu(n);
-  std::vector<Contribution> contributions;
-  for (int i = 0; i < n; ++i) {
-    const auto& in = pr.inputs[static_cast<std::size_t>(i)];
-    r.c.push_back(y.v(i));
-    cu(i) = y.v(i) * in.gufU();
-    Contribution c;
-    c.input = in.name;
-    c.type = in.type;
-    c.distribution = distributionName(in.distribution);
-    c.basis = "c = " + std::to_string(y.v(i));
-    c.u = std::fabs(cu(i));
-    c.dof = in.dof;
-    contributions.push_back(c);
-  }
-  const double u2 = r.correlated ? cu.dot(pr.correlation * cu) : cu.squaredNorm();
-  r.budget = combine(pr.output, pr.unit, r.y, contributions);
-  r.u_c = std::sqrt(std::max(0.0, u2));
-  r.budget.u_c = r.u_c;
-  double ws = 0;
-  for (const auto& c : r.budget.contributions)
-    if (std::isfinite(c.dof) && c.u > 0) ws += std::pow(c.u, 4) / c.dof;
-  r.nu_eff = ws > 0 ? std::pow(r.u_c, 4) / ws : std::numeric_limits<double>::infinity();
-  r.budget.nu_eff = r.nu_eff;
-  r.k = coverageFactor(p, std::isfinite(r.nu_eff) ? std::max(1.0, std::floor(r.nu_eff)) : r.nu_eff);
-  r.U = r.k * r.u_c;
-  r.budget.k = r.k;
-  r.budget.U = r.U;
-  return r;
+  std::vector<double> grad(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) grad[static_cast<std::size_t>(i)] = y.v(i);
+  return gufFromGradient(pr, y.a, grad, p);
 }
 
 template <class Model>
 McmResult monteCarlo(const Problem& pr, const Model& f, const McmOptions& o = {}) {
   pr.check();
   const std::size_t n = pr.inputs.size();
-  const long batch = o.fixed_trials > 0 ? o.fixed_trials
-                                        : (o.batch > 0 ? o.batch : std::max(10'000L, static_cast<long>(std::ceil(100.0 / (1.0 - o.p)))));
+  const long batch = detail::batchSize(o);
+  const long limit = o.fixed_trials > 0 ? o.fixed_trials : o.max_trials;
   std::vector<double> all;
   std::vector<McmResult> batches;
   McmResult out;
-  for (long done = 0; done < o.max_trials;) {
-    const std::vector<double> x = detail::sampleInputs(pr, batch, o.seed, done);
-    std::vector<double> y(static_cast<std::size_t>(batch));
-    for (long t = 0; t < batch; ++t) y[static_cast<std::size_t>(t)] = f(&x[static_cast<std::size_t>(t) * n]);
+  for (long done = 0; done < limit;) {
+    const long b = std::min(batch, limit - done);
+    const std::vector<double> x = detail::sampleInputs(pr, b, o.seed, done);
+    std::vector<double> y(static_cast<std::size_t>(b));
+    for (long t = 0; t < b; ++t) y[static_cast<std::size_t>(t)] = f(&x[static_cast<std::size_t>(t) * n]);
     all.insert(all.end(), y.begin(), y.end());
-    batches.push_back(detail::summarise(y, o.p));
-    done += batch;
+    done += b;
     if (o.progress) o.progress(done);
-    if (o.fixed_trials > 0) break;
-    if (batches.size() < 2) continue;
-    // JCGM 101 7.9.4: the standard deviations of the batch results, over sqrt(h).
-    const double h = static_cast<double>(batches.size());
-    auto spread = [&](auto get) {
-      double m = 0, s = 0;
-      for (const auto& b : batches) m += get(b);
-      m /= h;
-      for (const auto& b : batches) s += (get(b) - m) * (get(b) - m);
-      return std::sqrt(s / (h - 1) / h);
-    };
-    double u_mean = 0;
-    for (const auto& b : batches) u_mean += b.u;
-    const double delta = numericalTolerance(u_mean / h, o.significant_digits);
-    if (2 * spread([](const McmResult& b) { return b.y; }) <= delta &&
-        2 * spread([](const McmResult& b) { return b.u; }) <= delta &&
-        2 * spread([](const McmResult& b) { return b.symmetric_low; }) <= delta &&
-        2 * spread([](const McmResult& b) { return b.symmetric_high; }) <= delta) {
+    if (o.fixed_trials > 0) continue;
+    batches.push_back(detail::summarise(y, o.p));
+    if (detail::stable(batches, o.significant_digits)) {
       out.converged = true;
       break;
     }
