@@ -48,6 +48,16 @@ void printResolution(const evaluate::Resolution& r, double step_um) {
   }
 }
 
+void printPrediction(const parts::PlanManifest& m) {
+  const auto b = evaluate::predictLocationErrorBudgets(m);
+  std::printf("Predicted expanded uncertainty (k = 2) of each error of a cycle, before measuring\n"
+              "(d/2 = %s mm, %d points per sphere; drift and the d/2 term depend on measured values):\n",
+              formatNumber(m.radius_from_axis_mm).c_str(), m.pointsPerSphere());
+  for (const auto& x : b)
+    std::printf("  %-6s U = %7s %-4s  largest: %s\n", x.quantity.c_str(), formatNumber(x.U, 3).c_str(), x.unit.c_str(),
+                x.contributions.empty() ? "" : x.contributions.front().input.c_str());
+}
+
 int cmdPlan(const std::string& artifact_file, const std::string& machine_file,
             const std::string& out_dir, const std::string& dialect_opt) {
   const auto artifact = parts::loadSphereArtifact(artifact_file);
@@ -75,6 +85,7 @@ int cmdPlan(const std::string& artifact_file, const std::string& machine_file,
   std::printf("  (no acceleration; see docs/sphere-cycle.md for the comparison with 95 s)\n");
   printResolution(evaluate::locationErrorResolution(plan.manifest, machine.x.resolution_mm),
                   machine.x.resolution_mm * 1e3);
+  printPrediction(plan.manifest);
   return 0;
 }
 
@@ -82,6 +93,7 @@ int cmdResolution(const std::string& artifact_file, const std::string& machine_f
   const auto plan = planner::planSphereCycle(parts::loadSphereArtifact(artifact_file),
                                              parts::loadMachine(machine_file));
   printResolution(evaluate::locationErrorResolution(plan.manifest, step_um * 1e-3), step_um);
+  printPrediction(plan.manifest);
   return 0;
 }
 
@@ -160,6 +172,7 @@ int cmdEvaluate(const std::string& points_file, const std::string& manifest_file
   const auto e = evaluate::evaluateSphereCampaign(m, records, opt);
   writeFileAtomic(join(out_dir, "errors.csv"), evaluate::errorSeriesCsv(e));
   writeFileAtomic(join(out_dir, "evaluation.json"), evaluate::evaluationJson(e, m));
+  writeFileAtomic(join(out_dir, "report.md"), evaluate::evaluationReport(e, m));
 
   std::printf("Location errors of the C axis relative to cycle %d (least squares; U for k = 2)\n",
               e.reference_cycle);
@@ -183,8 +196,8 @@ int cmdEvaluate(const std::string& points_file, const std::string& manifest_file
   }
   for (const auto& [c, why] : e.incomplete)
     std::printf("Cycle %d not evaluated: %s\n", c, why.c_str());
-  std::printf("Wrote %s and %s\n", join(out_dir, "errors.csv").c_str(),
-              join(out_dir, "evaluation.json").c_str());
+  std::printf("Wrote %s, %s (budgets) and %s (report)\n", join(out_dir, "errors.csv").c_str(),
+              join(out_dir, "evaluation.json").c_str(), join(out_dir, "report.md").c_str());
 
   if (!scene_file.empty()) {
     std::vector<report::CycleCentres> cc;

@@ -38,6 +38,8 @@ class LocationLeastSquares {
   // d(error_j)/d(coordinate) in (um or urad)/mm: 7 x 3N, coordinates ordered x1,y1,z1,x2...
   // The same matrix applies to the cycle's centres and, negated, to the reference's.
   const Eigen::MatrixXd& sensitivity() const { return W_; }
+  // The first-order model: centre displacements (mm) = design() * errors (3N x 7).
+  const Eigen::MatrixXd& design() const { return A_; }
 
   // Residual standard deviation of the model fit to one cycle's displacements (um), and its
   // degrees of freedom (2N-4 in XY, N-3 in Z): a type A check of the rigid-body model.

@@ -54,6 +54,20 @@ std::string evaluationJson(const CampaignEvaluation& e, const parts::PlanManifes
   j["sign_conventions"] = "docs/conventions.md";
   j["incomplete_cycles"] = ordered_json::array();
   for (const auto& [c, why] : e.incomplete) j["incomplete_cycles"].push_back({{"cycle", c}, {"reason", why}});
+  j["point_scatter"] = {{"type_b_sigma_um", e.point_scatter.type_b_sigma_mm * 1e3},
+                        {"type_a_sigma_um", e.point_scatter.type_a_sigma_mm * 1e3},
+                        {"type_a_dof", e.point_scatter.type_a_dof},
+                        {"used", e.point_scatter.type_a_sigma_mm > e.point_scatter.type_b_sigma_mm ? "type A" : "type B"}};
+  j["centre_repeatability"] = ordered_json::array();
+  for (const auto& [pos, r] : e.centre_repeatability)
+    j["centre_repeatability"].push_back({{"position", pos},
+                                         {"cycles", r.n},
+                                         {"s_um", vec(r.s_um)},
+                                         {"U_single_um", vec(r.U_single_um)},
+                                         {"U_single_3d_um", r.U_single_3d_um},
+                                         {"U_mean_um", vec(r.U_mean_um)},
+                                         {"U_mean_3d_um", r.U_mean_3d_um},
+                                         {"note", "over the complete cycles, drift included (seed 004 Table 5.3 statistics)"}});
   for (const auto& c : e.cycles) {
     ordered_json jc;
     jc["cycle"] = c.cycle;
@@ -71,12 +85,14 @@ std::string evaluationJson(const CampaignEvaluation& e, const parts::PlanManifes
       jb["nu_eff"] = finiteOrNull(b.nu_eff);
       jb["k"] = b.k;
       jb["U"] = b.U;
+      jb["contributions"] = ordered_json::array();
       for (const auto& ct : b.contributions)
         jb["contributions"].push_back({{"input", ct.input},
                                        {"type", std::string(1, ct.type)},
                                        {"distribution", ct.distribution},
                                        {"basis", ct.basis},
-                                       {"u", ct.u}});
+                                       {"u", ct.u},
+                                       {"dof", finiteOrNull(ct.dof)}});
       jc["budgets"].push_back(jb);
     }
     for (const auto& s : c.spheres) {
@@ -103,6 +119,58 @@ std::string evaluationJson(const CampaignEvaluation& e, const parts::PlanManifes
     j["cycles"].push_back(jc);
   }
   return j.dump(1) + "\n";
+}
+
+std::string evaluationReport(const CampaignEvaluation& e, const parts::PlanManifest& m) {
+  std::ostringstream o;
+  o << "# Location errors of the C axis: results and uncertainty budgets\n\n";
+  o << "Manifest `" << e.manifest_file << "`, points `" << e.points_file << "`; errors relative to cycle "
+    << e.reference_cycle << " (least squares over positions";
+  for (int p : e.ls_positions) o << " " << p;
+  o << "; d/2 = " << formatNumber(m.radius_from_axis_mm) << " mm). U is the expanded uncertainty (k = "
+    << formatNumber(e.cycles.empty() ? 2.0 : e.cycles.front().budgets[0].k) << ").\n\n";
+  o << "Probe point scatter: specification sigma = " << formatNumber(e.point_scatter.type_b_sigma_mm * 1e3, 4)
+    << " um, pooled fit residual s = " << formatNumber(e.point_scatter.type_a_sigma_mm * 1e3, 4) << " um (nu = "
+    << formatNumber(e.point_scatter.type_a_dof) << "); the budgets use the larger.\n\n";
+  o << "## Range of U over the cycles\n\n| error | unit | smallest U | largest U | largest contribution (at the largest U) |\n|---|---|---|---|---|\n";
+  for (int j = 0; j < 7; ++j) {
+    const uncertainty::Budget* lo = nullptr;
+    const uncertainty::Budget* hi = nullptr;
+    for (const auto& c : e.cycles) {
+      if (c.cycle == e.reference_cycle) continue;
+      const auto& b = c.budgets[j];
+      if (!lo || b.U < lo->U) lo = &b;
+      if (!hi || b.U > hi->U) hi = &b;
+    }
+    if (!hi) continue;
+    o << "| " << hi->quantity << " | " << hi->unit << " | " << formatNumber(lo->U, 3) << " | " << formatNumber(hi->U, 3)
+      << " | " << (hi->contributions.empty() ? "" : hi->contributions.front().input) << " |\n";
+  }
+  const CycleEvaluation* last = e.cycles.empty() ? nullptr : &e.cycles.back();
+  if (last && last->cycle != e.reference_cycle) {
+    o << "\n## Budgets of cycle " << last->cycle << " (the last)\n";
+    for (const auto& b : last->budgets) {
+      o << "\n### " << b.quantity << " = " << formatNumber(b.value, 4) << " " << b.unit << ", U = " << formatNumber(b.U, 3)
+        << " " << b.unit << " (u_c = " << formatNumber(b.u_c, 3) << ", nu_eff = "
+        << (std::isfinite(b.nu_eff) ? formatNumber(b.nu_eff, 3) : std::string("inf")) << ", k = " << formatNumber(b.k, 3)
+        << ")\n\n| input | type | distribution | u (" << b.unit << ") | share of u_c^2 | basis |\n|---|---|---|---|---|---|\n";
+      for (const auto& c : b.contributions)
+        o << "| " << c.input << " | " << c.type << " | " << c.distribution << " | " << formatNumber(c.u, 3) << " | "
+          << formatNumber(b.u_c > 0 ? 100 * c.u * c.u / (b.u_c * b.u_c) : 0.0, 3) << " % | " << c.basis << " |\n";
+    }
+  }
+  if (!e.centre_repeatability.empty()) {
+    o << "\n## Sphere-centre repeatability over the cycles (seed 004 Table 5.3 statistics)\n\n"
+         "Drift between cycles is included (Table 5.3 measured one position continuously). U = 2 s for one "
+         "measurement, 2 s / sqrt(n) for the mean; 3D = root-sum-square of X, Y, Z.\n\n"
+         "| position | cycles | U X (um) | U Y (um) | U Z (um) | U 3D (um) | U 3D of the mean (um) |\n|---|---|---|---|---|---|---|\n";
+    for (const auto& [pos, r] : e.centre_repeatability)
+      o << "| " << pos << " | " << r.n << " | " << formatNumber(r.U_single_um.x(), 3) << " | "
+        << formatNumber(r.U_single_um.y(), 3) << " | " << formatNumber(r.U_single_um.z(), 3) << " | "
+        << formatNumber(r.U_single_3d_um, 3) << " | " << formatNumber(r.U_mean_3d_um, 3) << " |\n";
+  }
+  for (const auto& [c, why] : e.incomplete) o << "\nCycle " << c << " not evaluated: " << why << "\n";
+  return o.str();
 }
 
 }  // namespace probeloop::evaluate

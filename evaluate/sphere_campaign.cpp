@@ -41,17 +41,6 @@ std::vector<Vector3d> centresOf(const CycleEvaluation& c, const std::vector<int>
   return out;
 }
 
-// Variance of W_j . centres for one cycle when every point has standard deviation sigma.
-double propagated(const Eigen::MatrixXd& W, int j, const CycleEvaluation& c,
-                  const std::vector<int>& positions, double sigma_mm) {
-  double v = 0;
-  for (size_t k = 0; k < positions.size(); ++k) {
-    const Eigen::RowVector3d w = W.block<1, 3>(j, 3 * static_cast<Eigen::Index>(k));
-    v += (w * c.spheres[positions[k] - 1].centre_cov_unscaled() * w.transpose())(0, 0);
-  }
-  return std::sqrt(std::max(v, 0.0)) * sigma_mm;
-}
-
 }  // namespace
 
 CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& m,
@@ -92,15 +81,19 @@ CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& m,
         continue;
       }
       std::vector<Vector3d> pts;
+      double tp = 0;
       for (const auto* r : pit->second) {
         pts.push_back(r->tip_mm);
         const auto& planned = m.points[(s.position - 1) * m.pointsPerSphere() + (r->point - 1)];
-        t_sum += r->time_s ? *r->time_s : m.cycle_start_s[cyc - 1] + planned.time_in_cycle_s;
+        const double t = r->time_s ? *r->time_s : m.cycle_start_s[cyc - 1] + planned.time_in_cycle_s;
+        t_sum += t;
+        tp += t;
         ++t_n;
       }
       SphereMeasurement sm;
       sm.position = s.position;
       sm.points = n;
+      sm.time_s = tp / n;
       try {
         geometry::SphereFitOptions fo;
         fo.fixed_radius_mm = known_radius;
@@ -139,9 +132,22 @@ CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& m,
 
   const CycleEvaluation& ref = out.cycles.front();
   const auto ref_centres = centresOf(ref, layout.ls_positions);
-  const double sigma_probe_mm = m.probe_repeatability_2sigma_um / 2.0 * 1e-3;
-  const double sigma_res_mm = m.coordinate_resolution_mm / std::sqrt(12.0);
-  const auto& W = ls.sensitivity();
+
+  // Type A scatter of the points: pooled residuals of every free-radius fit. (Not the
+  // known-radius fits: the probe's mean pre-travel shrinks the apparent radius, a systematic
+  // misfit that cancels between cycles but would read as scatter there.)
+  double ssr = 0, dof = 0;
+  for (const auto& c : out.cycles)
+    for (const auto& s : c.spheres)
+      if (s.free_radius && s.free_radius->dof > 0) {
+        ssr += s.free_radius->rms_mm * s.free_radius->rms_mm * s.points;
+        dof += s.free_radius->dof;
+      }
+  out.point_scatter.type_b_sigma_mm = m.probe_repeatability_2sigma_um / 2.0 * 1e-3;
+  if (dof > 0) {
+    out.point_scatter.type_a_sigma_mm = std::sqrt(ssr / dof);
+    out.point_scatter.type_a_dof = dof;
+  }
 
   for (auto& c : out.cycles) {
     const auto centres = centresOf(c, layout.ls_positions);
@@ -162,32 +168,51 @@ CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& m,
         c.repeats.push_back({s.position, s.repeat_of,
                              (c.spheres[s.position - 1].centre_mm() -
                               c.spheres[s.repeat_of - 1].centre_mm()) * 1e3});
-    const auto values = c.least_squares.values();
-    const bool is_ref = c.cycle == out.reference_cycle;
-    for (int j = 0; j < 7; ++j) {
-      std::string name = LocationErrors::names()[j];
-      const std::string unit = name.substr(name.find('_') + 1);
-      name = name.substr(0, name.find('_'));
-      std::vector<uncertainty::Contribution> contrib;
-      if (!is_ref) {  // the reference cycle's errors are zero by definition
-        const std::string probe_basis = "machine probe.repeatability_2sigma = " +
-                                        formatNumber(m.probe_repeatability_2sigma_um) + " um";
-        const std::string res_basis = "coordinate resolution " +
-                                      formatNumber(m.coordinate_resolution_mm * 1e3) + " um";
-        contrib.push_back({"probe repeatability, this cycle", 'B', "normal", probe_basis,
-                           propagated(W, j, c, layout.ls_positions, sigma_probe_mm)});
-        contrib.push_back({"probe repeatability, reference cycle", 'B', "normal", probe_basis,
-                           propagated(W, j, ref, layout.ls_positions, sigma_probe_mm)});
-        contrib.push_back({"coordinate resolution, this cycle", 'B', "rectangular", res_basis,
-                           propagated(W, j, c, layout.ls_positions, sigma_res_mm)});
-        contrib.push_back({"coordinate resolution, reference cycle", 'B', "rectangular", res_basis,
-                           propagated(W, j, ref, layout.ls_positions, sigma_res_mm)});
-        contrib.push_back({"sphere form error", 'B', "rectangular",
-                           "cancels: the same sphere points are probed in every cycle", 0.0});
+  }
+
+  // Budget inputs per cycle: fit covariances, each position's time in the cycle, and the
+  // error rates from the neighbouring cycles (central differences; one-sided at the ends).
+  const auto n_cycles = out.cycles.size();
+  std::vector<CycleBudgetInput> inputs(n_cycles);
+  for (std::size_t i = 0; i < n_cycles; ++i) {
+    const auto& c = out.cycles[i];
+    auto& in = inputs[i];
+    for (int p : layout.ls_positions) {
+      const auto& s = c.spheres[static_cast<std::size_t>(p - 1)];
+      in.centre_cov_unscaled.push_back(s.centre_cov_unscaled());
+      in.points.push_back(s.points);
+      in.tau_s.push_back(s.time_s - c.time_s);
+    }
+    if (n_cycles >= 2) {
+      const std::size_t lo = i == 0 ? 0 : i - 1, hi = i + 1 == n_cycles ? i : i + 1;
+      const double dt = out.cycles[hi].time_s - out.cycles[lo].time_s;
+      if (dt > 0) {
+        const auto a = out.cycles[lo].least_squares.values(), b = out.cycles[hi].least_squares.values();
+        for (int j = 0; j < 7; ++j) in.rate_per_s[static_cast<std::size_t>(j)] = (b[j] - a[j]) / dt;
+        in.rate_known = true;
       }
-      c.budgets[j] = uncertainty::combine(name, unit, values[j], contrib, opt.coverage_k);
     }
   }
+  for (std::size_t i = 0; i < n_cycles; ++i) {
+    auto& c = out.cycles[i];
+    const auto values = c.least_squares.values();
+    if (c.cycle == out.reference_cycle) {  // its errors are zero by definition
+      for (int j = 0; j < 7; ++j) {
+        std::string name = LocationErrors::names()[j];
+        const std::string unit = name.substr(name.find('_') + 1);
+        c.budgets[j] = uncertainty::combine(name.substr(0, name.find('_')), unit, values[j], {}, opt.coverage_k);
+      }
+      continue;
+    }
+    c.budgets = locationErrorBudgets(ls, m, inputs[i], inputs[0], values, out.point_scatter, opt.coverage_k);
+  }
+
+  if (out.cycles.size() >= 2)
+    for (const auto& s : m.spheres) {
+      std::vector<Vector3d> cs;
+      for (const auto& c : out.cycles) cs.push_back(c.spheres[static_cast<std::size_t>(s.position - 1)].centre_mm());
+      out.centre_repeatability.push_back({s.position, centreRepeatability(cs)});
+    }
   return out;
 }
 

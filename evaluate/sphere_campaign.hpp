@@ -8,11 +8,10 @@
 // - The reference is the first complete cycle (cycle 1 when it is complete).
 // - The least-squares estimator uses the positions that are not repeats (the 5th position
 //   of the thesis repeats the 1st and is reported as a repeatability indicator).
-// - Budgets propagate each sphere centre's covariance through the estimator's linear
-//   sensitivities: probe repeatability (type B, normal, sigma = 2-sigma spec / 2) and
-//   coordinate resolution (type B, rectangular, q / sqrt(12)) of every point, in this cycle
-//   and in the reference cycle; the sphere's form error cancels (the same sphere points are
-//   probed in every cycle) and is listed with zero contribution.
+// - Every least-squares value carries the budget of evaluate/location_budget.hpp (probe
+//   scatter type A/B, resolution, tool change, form, artifact expansion, d/2, drift during
+//   the cycle), for this cycle and the reference cycle; the reference cycle's errors are 0
+//   by definition and carry an empty budget.
 #pragma once
 #include <array>
 #include <optional>
@@ -20,6 +19,7 @@
 #include <vector>
 
 #include "evaluate/ingest.hpp"
+#include "evaluate/location_budget.hpp"
 #include "geometry/location_errors.hpp"
 #include "geometry/sphere_fit.hpp"
 #include "parts/plan_manifest.hpp"
@@ -35,6 +35,7 @@ struct EvaluateOptions {
 struct SphereMeasurement {
   int position = 0;
   int points = 0;
+  double time_s = 0;  // mean (logged or planned) time of its points
   geometry::SphereFit known_radius;       // radius fixed to R_sphere + r_tip
   std::optional<geometry::SphereFit> free_radius;  // absent when not determinable
   std::string free_radius_note;
@@ -70,6 +71,10 @@ struct CampaignEvaluation {
   bool formulas_applicable = false;
   std::vector<CycleEvaluation> cycles;    // complete cycles, ascending
   std::vector<std::pair<int, std::string>> incomplete;  // cycle, reason
+  PointScatter point_scatter;  // what the budgets used (type B spec, type A pooled)
+  // Per position, over the complete cycles: seed 004 Table 5.3's statistics (they include
+  // the drift between cycles; Table 5.3 measured one position continuously).
+  std::vector<std::pair<int, CentreRepeatability>> centre_repeatability;
 };
 
 CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& manifest,
@@ -79,6 +84,9 @@ CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& manifest,
 // Error series CSV (DESIGN.md §3): time_s,cycle,<7 errors>,U_<7 errors>.
 std::string errorSeriesCsv(const CampaignEvaluation& e);
 std::string evaluationJson(const CampaignEvaluation& e, const parts::PlanManifest& m);
+// A Markdown report: the range of U per error, the full budgets of the last cycle, the
+// centre repeatability table.
+std::string evaluationReport(const CampaignEvaluation& e, const parts::PlanManifest& m);
 
 // Theoretical resolution of each error (seed 004 L1444, Table 5.4): the largest change of
 // the error when one centre coordinate of the cycle changes by one step, for the formulas

@@ -153,6 +153,9 @@ Machine loadMachine(const std::string& path) {
   mc.probe.length_mm = pr.quantity("length", Dimension::Length);
   mc.probe.tip_diameter_mm = pr.quantity("tip_diameter", Dimension::Length);
   mc.probe.repeatability_2sigma_um = pr.quantity("repeatability_2sigma", Dimension::Micrometre);
+  mc.probe.tool_change_repeatability_2sigma_um = pr.quantityOr("tool_change_repeatability_2sigma", Dimension::Micrometre, NAN);
+  if (pr.has("tool_change_repeatability_2sigma") && !(mc.probe.tool_change_repeatability_2sigma_um >= 0))
+    pr.fail("tool_change_repeatability_2sigma", "must be >= 0");
   if (mc.probe.tool <= 0) pr.fail("tool", "probe tool number must be positive");
   if (mc.probe.tool == mc.tool_change.empty_tool)
     pr.fail("tool", "probe tool number equals tool_change.empty_tool");

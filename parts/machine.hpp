@@ -4,6 +4,7 @@
 // controlled point is the stylus-tip centre, so "tip coordinates" = machine coordinates of
 // the gauge line minus (0, 0, probe.length). Travel limits apply to the gauge line.
 #pragma once
+#include <cmath>
 #include <Eigen/Dense>
 #include <array>
 #include <string>
@@ -35,6 +36,7 @@ struct ProbeSpec {
   double length_mm = 0;                 // gauge line to stylus-tip centre (tool table)
   double tip_diameter_mm = 0;
   double repeatability_2sigma_um = 0;   // manufacturer's unidirectional repeatability (2 sigma)
+  double tool_change_repeatability_2sigma_um = NAN;  // of the probe's position after a tool change; NaN = not stated
 };
 
 struct ToolChangeSpec {

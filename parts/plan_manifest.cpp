@@ -2,6 +2,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
+
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 
@@ -35,6 +37,13 @@ Eigen::Vector3d readVec(const ordered_json& j, const std::string& file, const st
 }
 }  // namespace
 
+namespace {
+ordered_json orNull(double v) { return std::isfinite(v) ? ordered_json(v) : ordered_json(); }
+double optional(const ordered_json& j, const char* key) {
+  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : NAN;
+}
+}  // namespace
+
 std::string manifestToJson(const PlanManifest& m) {
   ordered_json j;
   j["format"] = "probeloop-plan-manifest";
@@ -50,10 +59,15 @@ std::string manifestToJson(const PlanManifest& m) {
                   {"coordinate_resolution_mm", m.coordinate_resolution_mm}};
   j["probe"] = {{"tool", m.probe_tool},
                 {"tip_radius_mm", m.tip_radius_mm},
-                {"repeatability_2sigma_um", m.probe_repeatability_2sigma_um}};
+                {"repeatability_2sigma_um", m.probe_repeatability_2sigma_um},
+                {"tool_change_repeatability_2sigma_um", orNull(m.probe_tool_change_repeatability_2sigma_um)}};
   j["artifact"] = {{"sphere_radius_mm", m.sphere_radius_mm},
                    {"sphere_form_error_um", m.sphere_form_error_um},
-                   {"radius_from_axis_mm", m.radius_from_axis_mm}};
+                   {"radius_from_axis_mm", m.radius_from_axis_mm},
+                   {"sphere_centre_height_mm", orNull(m.sphere_centre_height_mm)},
+                   {"radius_from_axis_u_mm", orNull(m.radius_from_axis_u_mm)},
+                   {"alpha_um_per_m_K", orNull(m.artifact_alpha_um_per_m_K)},
+                   {"temperature_change_half_width_K", orNull(m.artifact_temperature_change_half_width_K)}};
   for (const auto& s : m.spheres) {
     j["features"].push_back({{"id", s.id},
                              {"kind", "sphere"},
@@ -76,6 +90,7 @@ std::string manifestToJson(const PlanManifest& m) {
   }
   j["schedule"] = {{"cycles", m.cycles},
                    {"gap_s", m.gap_s},
+                   {"tool_change_each_cycle", m.tool_change_each_cycle},
                    {"cycle_time_s", m.cycle_time_s},
                    {"cycle_start_s", m.cycle_start_s}};
   return j.dump(1) + "\n";
@@ -111,10 +126,15 @@ PlanManifest readManifest(const std::string& path) {
     m.probe_tool = pr.at("tool");
     m.tip_radius_mm = pr.at("tip_radius_mm");
     m.probe_repeatability_2sigma_um = pr.at("repeatability_2sigma_um");
+    m.probe_tool_change_repeatability_2sigma_um = optional(pr, "tool_change_repeatability_2sigma_um");
     const auto& a = j.at("artifact");
     m.sphere_radius_mm = a.at("sphere_radius_mm");
     m.sphere_form_error_um = a.at("sphere_form_error_um");
     m.radius_from_axis_mm = a.at("radius_from_axis_mm");
+    m.sphere_centre_height_mm = optional(a, "sphere_centre_height_mm");
+    m.radius_from_axis_u_mm = optional(a, "radius_from_axis_u_mm");
+    m.artifact_alpha_um_per_m_K = optional(a, "alpha_um_per_m_K");
+    m.artifact_temperature_change_half_width_K = optional(a, "temperature_change_half_width_K");
     for (const auto& f : j.at("features")) {
       ManifestSphere s;
       s.id = f.at("id");
@@ -138,6 +158,7 @@ PlanManifest readManifest(const std::string& path) {
     }
     const auto& s = j.at("schedule");
     m.cycles = s.at("cycles");
+    m.tool_change_each_cycle = s.value("tool_change_each_cycle", false);
     m.gap_s = s.at("gap_s");
     m.cycle_time_s = s.at("cycle_time_s");
     m.cycle_start_s = s.at("cycle_start_s").get<std::vector<double>>();

@@ -49,6 +49,13 @@ struct PlanManifest {
   double sphere_radius_mm = 0;
   double sphere_form_error_um = 0;
   double radius_from_axis_mm = 0;  // d/2
+  // Budget inputs; NaN = not stated.
+  double probe_tool_change_repeatability_2sigma_um = NAN;
+  double sphere_centre_height_mm = NAN;  // above the table surface
+  double radius_from_axis_u_mm = NAN;
+  double artifact_alpha_um_per_m_K = NAN;
+  double artifact_temperature_change_half_width_K = NAN;
+  bool tool_change_each_cycle = false;
   std::vector<ManifestSphere> spheres;
   std::vector<ManifestPoint> points;
   // Schedule.

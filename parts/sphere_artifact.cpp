@@ -70,6 +70,19 @@ SphereArtifact loadSphereArtifact(const std::string& path) {
   if (a.gap_s < 0) c.fail("gap", "must not be negative");
   a.tool_change_each_cycle = c.boolean("tool_change_each_cycle");
   c.finish();
+
+  if (auto u = root.mapIfPresent("uncertainty")) {
+    a.radius_from_axis_u_mm = u->quantityOr("radius_from_c_axis_u", Dimension::Length, NAN);
+    a.alpha_um_per_m_K = u->numberOr("alpha_um_per_m_K", NAN);
+    a.temperature_change_half_width_K = u->quantityOr("temperature_change_half_width", Dimension::Temperature, NAN);
+    if (u->has("radius_from_c_axis_u") && !(a.radius_from_axis_u_mm >= 0))
+      u->fail("radius_from_c_axis_u", "a standard uncertainty must be >= 0");
+    if (u->has("alpha_um_per_m_K") && !(a.alpha_um_per_m_K >= 0 && a.alpha_um_per_m_K < 100))
+      u->fail("alpha_um_per_m_K", "expected an expansion coefficient in um/(m K), e.g. 11.5 for steel");
+    if (u->has("temperature_change_half_width") && !(a.temperature_change_half_width_K >= 0))
+      u->fail("temperature_change_half_width", "a half-width must be >= 0");
+    u->finish();
+  }
   root.finish();
   return a;
 }

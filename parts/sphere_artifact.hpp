@@ -1,6 +1,7 @@
 // Sphere artifact on the rotary table (YAML, kind: sphere_artifact), seed 004 Ch. 5.
 // Schema: docs/formats.md#sphere-artifact. Lengths in mm, angles in degrees.
 #pragma once
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,10 @@ struct SphereArtifact {
   double duration_s = 0;               // ... or a duration (count derived)
   double gap_s = 300;                  // end of one cycle to start of the next
   bool tool_change_each_cycle = true;  // probe in and out every cycle (seed 004: 2 ATC)
+  // Budget inputs (docs/uncertainty.md); NaN = not stated (listed in the budget as such).
+  double radius_from_axis_u_mm = NAN;           // standard uncertainty of d/2
+  double alpha_um_per_m_K = NAN;                // stem and sphere material
+  double temperature_change_half_width_K = NAN;  // bound of the artifact's uncorrected temperature change
 
   double sphereRadius() const { return sphere_diameter_mm / 2; }
   double centreHeightAboveTable() const { return stem_length_mm + sphereRadius(); }

@@ -252,6 +252,12 @@ SpherePlan planSphereCycle(const SphereArtifact& a, const Machine& m, const Plan
   man.sphere_radius_mm = R;
   man.sphere_form_error_um = a.sphere_form_error_um;
   man.radius_from_axis_mm = a.radius_from_axis_mm;
+  man.probe_tool_change_repeatability_2sigma_um = m.probe.tool_change_repeatability_2sigma_um;
+  man.sphere_centre_height_mm = a.centreHeightAboveTable();
+  man.radius_from_axis_u_mm = a.radius_from_axis_u_mm;
+  man.artifact_alpha_um_per_m_K = a.alpha_um_per_m_K;
+  man.artifact_temperature_change_half_width_K = a.temperature_change_half_width_K;
+  man.tool_change_each_cycle = a.tool_change_each_cycle;
   man.cycles = cycles;
   man.gap_s = a.gap_s;
   man.cycle_time_s = T;

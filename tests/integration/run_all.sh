@@ -113,12 +113,35 @@ fi
 # --- the virtual machine: the emitted programs run, the evaluation finds the truth --------
 LCNC_PLAN="$W/lc"; FA_PLAN="$W/p"
 CAMP=$SRC/examples/truth_campaign.yaml
+"$PL" plan "$ART" --machine "$NMV" --out "$W/pred" > "$W/pred.txt"
+check "plan predicts U of every error before measuring" grep -Eq "EC0C +U = +[0-9.]+ urad" "$W/pred.txt"
 check "simulate runs the Fanuc program" "$PL" simulate "$FA_PLAN/sphere_cycle.nc" --machine "$NMV" --part "$ART" --truth "$CAMP" --out "$W/v" --seed 3
 "$PL" evaluate "$W/v/dprnt.txt" --format fanuc --manifest "$FA_PLAN/plan.json" --out "$W/v/e" > /dev/null
 check "simulated Fanuc campaign: truth recovered within U (coverage)" python3 "$SRC/tests/integration/compare_errors.py" "$W/v/e/errors.csv" "$W/v/truth.json" 0 0 --coverage
 "$PL" evaluate "$W/v/points.csv" --manifest "$FA_PLAN/plan.json" --out "$W/v/c" > /dev/null
-# The CSV carries the trigger times, the log does not (planned times): compare without them.
-check "simulated points CSV and DPRNT log agree (1 um quantised)" cmp <(cut -d, -f2- "$W/v/e/errors.csv") <(cut -d, -f2- "$W/v/c/errors.csv")
+check "evaluate: every value's budget lists each input of docs/uncertainty.md, and report.md" python3 - "$W/v/e/evaluation.json" "$W/v/e/report.md" <<'PY'
+import json, sys
+j = json.load(open(sys.argv[1]))
+need = ["probe repeatability (specification)", "probe point scatter (type A)", "coordinate resolution",
+        "tool-change repeatability", "drift during the cycle", "sphere form error"]
+for c in j["cycles"][1:]:
+    for b in c["budgets"]:
+        inputs = [x["input"] for x in b["contributions"]]
+        for n in need:
+            assert any(i.startswith(n) for i in inputs), (c["cycle"], b["quantity"], n)
+        u = sum(x["u"] ** 2 for x in b["contributions"]) ** 0.5
+        assert abs(u - b["u_c"]) < 1e-12 and abs(b["U"] - b["k"] * b["u_c"]) < 1e-12, b
+        if b["quantity"] == "EZ0T":
+            assert any(i == "artifact temperature and expansion" and x["u"] > 0 for x in b["contributions"] for i in [x["input"]])
+        if b["quantity"] in ("EA0C", "EB0C", "EC0C"):
+            assert any(x["input"] == "uncertainty of d/2" for x in b["contributions"])
+r = open(sys.argv[2]).read()
+assert "## Range of U over the cycles" in r and "Table 5.3" in r
+print("ok")
+PY
+# The CSV carries the trigger times, the log does not (planned times): compare the values
+# without the times (U differs slightly: the drift term uses each position's time).
+check "simulated points CSV and DPRNT log agree (1 um quantised)" cmp <(cut -d, -f2-9 "$W/v/e/errors.csv") <(cut -d, -f2-9 "$W/v/c/errors.csv")
 check "simulate runs the LinuxCNC program" "$PL" simulate "$LCNC_PLAN/sphere_cycle.ngc" --machine "$LCNC" --part "$W/art2.yaml" --truth "$CAMP" --out "$W/vl" --seed 3
 "$PL" evaluate "$W/vl/sphere_probe.log" --manifest "$LCNC_PLAN/plan.json" --out "$W/vl/e" > /dev/null
 check "simulated LinuxCNC campaign: truth recovered within U (coverage)" python3 "$SRC/tests/integration/compare_errors.py" "$W/vl/e/errors.csv" "$W/vl/truth.json" 0 0 --coverage
