@@ -14,7 +14,8 @@ static void BM_McmLocationError(benchmark::State& state) {
     const auto r = uncertainty::monteCarlo(p, bench::LocationErrorModel{}, o);
     benchmark::DoNotOptimize(r.u);
     state.counters["u_um_per_m"] = r.u;
-    state.counters["U95_high"] = r.symmetric_high;
+    state.counters["interval_low"] = r.symmetric_low;
+    state.counters["interval_high"] = r.symmetric_high;
   }
   state.SetItemsProcessed(state.iterations() * state.range(0));
 }

@@ -17,11 +17,11 @@ inline uncertainty::Problem locationErrorProblem() {
   p.unit = "um/m";
   const double u_xy = 0.5 * std::sqrt(0.5), u_z = 0.5;  // (J^T J)^-1 = diag(1/2, 1/2, 1)
   const char* axes[3] = {"x", "y", "z"};
-  for (const char* cyc : {"i", "1"})
+  for (const std::string cyc : {"i", "1"})
     for (int k = 1; k <= 4; ++k)
-      for (int a = 0; a < 3; ++a)
+      for (int a = 0; a < 3; ++a)  // z of position 2 of this cycle 3 um up: EA0C = 3 um / 0.32 m
         p.inputs.push_back(uncertainty::Input::normal(std::string(axes[a]) + "_" + cyc + "," + std::to_string(k),
-                                                      k == 2 && a == 2 ? 3.0 : 0.0, a == 2 ? u_z : u_xy));
+                                                      cyc == "i" && k == 2 && a == 2 ? 3.0 : 0.0, a == 2 ? u_z : u_xy));
   p.inputs.push_back(uncertainty::Input::normal("d/2", 160.0, 0.05));
   for (const char* cyc : {"i", "1"})
     for (int a = 0; a < 3; ++a)

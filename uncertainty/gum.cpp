@@ -4,6 +4,8 @@
 #include <boost/math/distributions/normal.hpp>
 #include <boost/math/distributions/students_t.hpp>
 #include <iomanip>
+#include <boost/random/normal_distribution.hpp>
+#include <boost/random/uniform_01.hpp>
 #include <random>
 #include <sstream>
 
@@ -196,8 +198,10 @@ void undefinedAtEstimate(const std::string& output) {
 std::vector<double> sampleInputs(const Problem& p, long trials, std::uint64_t seed, long offset) {
   const std::size_t n = p.inputs.size();
   std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ULL + static_cast<std::uint64_t>(offset) + 1);
-  std::normal_distribution<double> N(0.0, 1.0);
-  std::uniform_real_distribution<double> U(0.0, 1.0);
+  // Boost's normal is a ziggurat (several times faster than the polar method of libstdc++);
+  // with 1e6 trials of 32 inputs the draws dominate the Monte Carlo time.
+  boost::random::normal_distribution<double> N(0.0, 1.0);
+  boost::random::uniform_01<double> U;
   const bool corr = p.correlation.size() > 0;
   Eigen::MatrixXd L;
   if (corr) {
