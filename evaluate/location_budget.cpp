@@ -77,22 +77,24 @@ std::array<uncertainty::Budget, 7> locationErrorBudgets(const LocationLeastSquar
                    double dof = std::numeric_limits<double>::infinity()) {
       cs.push_back({std::move(input), type, std::move(dist), std::move(basis), u, dof});
     };
+    // Point scatter and resolution: the same sigma in this and the reference cycle, so one
+    // contribution each (a type A s enters once with its dof, not twice).
+    const double v_fit = std::pow(throughFit(W, j, c, 1.0), 2) + std::pow(throughFit(W, j, ref, 1.0), 2);
+    const std::string both = ", this and the reference cycle";
+    if (use_a) {
+      add("probe point scatter (type A)" + both, 'A', "normal", pooled, sigma * std::sqrt(v_fit), ps.type_a_dof);
+      add("probe repeatability (specification)" + both, 'B', "normal",
+          spec + "; not added: the type A estimate of the same scatter is larger", 0);
+    } else {
+      add("probe repeatability (specification)" + both, 'B', "normal", spec, sigma * std::sqrt(v_fit));
+      if (ps.type_a_dof > 0)
+        add("probe point scatter (type A)" + both, 'A', "normal", pooled + "; not added: the specification is larger", 0,
+            ps.type_a_dof);
+    }
+    add("coordinate resolution" + both, 'B', "rectangular", "q = " + num(q * 1e3) + " um per coordinate, q/sqrt(12)",
+        q / std::sqrt(12.0) * std::sqrt(v_fit));
     for (int which = 0; which < 2; ++which) {
-      const CycleBudgetInput& x = which ? ref : c;
       const std::string cyc = which ? ", reference cycle" : ", this cycle";
-      const double u = throughFit(W, j, x, sigma);
-      if (use_a) {
-        add("probe point scatter (type A)" + cyc, 'A', "normal", pooled, u, ps.type_a_dof);
-        add("probe repeatability (specification)" + cyc, 'B', "normal",
-            spec + "; not added: the type A estimate of the same scatter is larger", 0);
-      } else {
-        add("probe repeatability (specification)" + cyc, 'B', "normal", spec, u);
-        if (ps.type_a_dof > 0)
-          add("probe point scatter (type A)" + cyc, 'A', "normal",
-              pooled + "; not added: the specification is larger", 0, ps.type_a_dof);
-      }
-      add("coordinate resolution" + cyc, 'B', "rectangular", "q = " + num(q * 1e3) + " um per coordinate, q/sqrt(12)",
-          throughFit(W, j, x, q / std::sqrt(12.0)));
       if (m.tool_change_each_cycle) {
         if (std::isfinite(atc))
           add("tool-change repeatability" + cyc, 'B', "normal",
@@ -103,17 +105,19 @@ std::array<uncertainty::Budget, 7> locationErrorBudgets(const LocationLeastSquar
           add("tool-change repeatability" + cyc, 'B', "normal",
               "not stated: set probe.tool_change_repeatability_2sigma in the machine file", 0);
       }
-      if (predicted) {
-        add("drift during the cycle" + cyc, 'B', "rectangular", "needs measured cycles (not predicted)", 0);
-      } else if (x.rate_known) {
-        const double b = driftBias(ls, j, x);
-        add("drift during the cycle" + cyc, 'B', "rectangular",
-            "error rates from the neighbouring cycles x each position's time in the cycle; half-width " +
-                num(std::fabs(b)) + " " + kUnits[j],
-            std::fabs(b) / std::sqrt(3.0));
-      } else {
-        add("drift during the cycle" + cyc, 'B', "rectangular", "one complete cycle only: no rate to estimate it", 0);
-      }
+    }
+    // Drift: E = W (c_i - c_ref), so the biases of the two cycles subtract (a steady drift
+    // probed with the same timing cancels).
+    if (predicted) {
+      add("drift during the cycle", 'B', "rectangular", "needs measured cycles (not predicted)", 0);
+    } else if (c.rate_known && ref.rate_known) {
+      const double b = driftBias(ls, j, c) - driftBias(ls, j, ref);
+      add("drift during the cycle", 'B', "rectangular",
+          "error rates from the neighbouring cycles x each position's time in the cycle, this cycle minus the "
+          "reference; half-width " + num(std::fabs(b)) + " " + kUnits[j],
+          std::fabs(b) / std::sqrt(3.0));
+    } else {
+      add("drift during the cycle", 'B', "rectangular", "one complete cycle only: no rate to estimate it", 0);
     }
     add("sphere form error", 'B', "rectangular",
         "form " + num(m.sphere_form_error_um) + " um; cancels: the same sphere points are probed in every cycle", 0);
@@ -133,8 +137,9 @@ std::array<uncertainty::Budget, 7> locationErrorBudgets(const LocationLeastSquar
       const double uR = m.radius_from_axis_u_mm;
       if (predicted)
         add("uncertainty of d/2", 'B', "normal",
-            "|E| u(d/2) / (d/2) = |E| x " + num(std::isfinite(uR) ? uR / m.radius_from_axis_mm : NAN) +
-                ": scales with the measured value",
+            std::isfinite(uR) ? "|E| u(d/2) / (d/2) = |E| x " + num(uR / m.radius_from_axis_mm) +
+                                    ": scales with the measured value"
+                              : std::string("not stated: set uncertainty.radius_from_c_axis_u in the artifact file"),
             0);
       else if (std::isfinite(uR))
         add("uncertainty of d/2", 'B', "normal",

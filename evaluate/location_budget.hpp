@@ -16,7 +16,10 @@
 // - d/2: the angular errors are displacements over d, so u = |E| u(d/2) / (d/2);
 // - drift during the cycle: each position is probed at its own time; with the error rates r
 //   (from neighbouring cycles) the centres carry A_k r tau_k, which W turns into a bias of
-//   every error. Rectangular with that bias as half-width, this and the reference cycle.
+//   every error; E = W (c_i - c_ref), so the bias is b_i - b_ref (a steady drift probed with
+//   the same timing cancels). Rectangular with that half-width.
+// Point scatter and resolution enter once for both cycles (the same sigma; a type A s must
+// not be counted twice with its dof); the tool change is an independent event per cycle.
 // Inputs the description does not state are listed with 0 and "not stated: <where to set it>".
 #pragma once
 #include <array>

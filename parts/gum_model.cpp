@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <map>
+#include <set>
 #include <sstream>
 
 #include "core/atomic_file.hpp"
@@ -88,6 +89,17 @@ std::string caret(const std::string& file_text, int line, int file_column, const
   for (int i = 0; i < line && std::getline(in, l); ++i) {
   }
   std::ostringstream o;
+  if (expr.find('\n') != std::string::npos) {  // a block scalar: show the expression's own line
+    on_file_line = false;
+    std::size_t start = 0, col = static_cast<std::size_t>(expr_column - 1);
+    int l_no = 1;
+    for (std::size_t k = 0; k < col && k < expr.size(); ++k)
+      if (expr[k] == '\n') start = k + 1, ++l_no;
+    const std::size_t end = expr.find('\n', start);
+    o << " (line " << l_no << " of the expression)\n  " << expr.substr(start, end == std::string::npos ? end : end - start)
+      << "\n  " << std::string(col - start, ' ') << "^";
+    return o.str();
+  }
   on_file_line = file_column > 0 && static_cast<std::size_t>(file_column - 1) <= l.size() &&
                  l.compare(static_cast<std::size_t>(file_column - 1), expr.size(), expr) == 0;
   if (on_file_line) {
@@ -156,30 +168,36 @@ uncertainty::TextModel loadGumModel(const std::string& path) {
     const YAML::Node list = root.raw("correlations");
     if (!list.IsSequence()) root.fail("correlations", "expected a list of [input, input, r]");
     if (m.inputs.correlation.size() == 0) m.inputs.correlation = Eigen::MatrixXd::Identity(n, n);
+    std::set<std::pair<std::size_t, std::size_t>> given;
     for (const auto& item : list) {
       const int line = item.Mark().line + 1;
-      if (!item.IsSequence() || item.size() != 3)
+      if (!item.IsSequence() || item.size() != 3 || !item[0].IsScalar() || !item[1].IsScalar() || !item[2].IsScalar())
         throw InputError(path, line, "correlations: each entry is [input, input, r], e.g. [V, I, -0.36]");
-      const std::string a = item[0].as<std::string>(), b = item[1].as<std::string>();
+      const std::string a = item[0].Scalar(), b = item[1].Scalar();
       double r = 0;
-      if (!parseFiniteNumber(item[2].as<std::string>(), r) || std::fabs(r) > 1)
+      if (!parseFiniteNumber(item[2].Scalar(), r) || std::fabs(r) > 1)
         throw InputError(path, line, "correlations: r must be a number in [-1, 1]");
       for (const auto& s : {a, b})
         if (!index.count(s)) throw InputError(path, line, "correlations: unknown input '" + s + "'");
       if (a == b) throw InputError(path, line, "correlations: an input is correlated with itself by definition (r = 1)");
       const auto i = static_cast<Eigen::Index>(index[a]), j = static_cast<Eigen::Index>(index[b]);
+      if (!given.insert({std::min(index[a], index[b]), std::max(index[a], index[b])}).second)
+        throw InputError(path, line, "correlations: r(" + a + ", " + b + ") is given twice");
       m.inputs.correlation(i, j) = m.inputs.correlation(j, i) = r;
     }
   }
   try {
     m.inputs.check();
   } catch (const InputError& e) {
-    throw InputError(path, 0, e.what());
+    throw InputError(path, root.has("correlations") ? root.line("correlations") : root.line("inputs"), e.what());
   }
 
+  std::set<std::string> output_names;
   for (auto& out : root.mapList("outputs")) {
     uncertainty::TextOutput o;
     o.name = out.string("name");
+    if (o.name.empty()) out.fail("name", "an output needs a name");
+    if (!output_names.insert(o.name).second) out.fail("name", "output '" + o.name + "' is defined twice");
     o.unit = out.stringOr("unit", "");
     const std::string expr = out.string("model");
     o.line = out.line("model");

@@ -1,6 +1,7 @@
 #include "uncertainty/expression.hpp"
 
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
 #include <map>
 
@@ -22,7 +23,7 @@ class ExpressionParser {
     const int root = sum();
     skip();
     if (pos_ < s_.size())
-      fail(pos_, std::string("unexpected '") + s_[pos_] + "': expected an operator (+ - * / ^) or the end");
+      fail(pos_, "unexpected '" + characterAt(pos_) + "': expected an operator (+ - * / ^) or the end");
     return root;
   }
 
@@ -43,6 +44,8 @@ class ExpressionParser {
     return false;
   }
   int add(Expression::Node n) {
+    // Bounded, so evaluation (recursive over the tree) cannot exhaust the stack.
+    if (e_.nodes_.size() >= 10000) fail(pos_, "the expression is too long (more than 10000 terms)");
     e_.nodes_.push_back(n);
     return static_cast<int>(e_.nodes_.size()) - 1;
   }
@@ -70,7 +73,16 @@ class ExpressionParser {
       else return left;
     }
   }
+  struct Depth {
+    explicit Depth(ExpressionParser& p) : p_(p) {
+      if (++p_.depth_ > 200) p_.fail(p_.pos_, "the expression is nested too deeply (more than 200 levels)");
+    }
+    ~Depth() { --p_.depth_; }
+    ExpressionParser& p_;
+  };
+
   int unary() {
+    Depth guard(*this);
     if (accept('-')) {
       const int v = unary();
       auto& n = e_.nodes_[static_cast<std::size_t>(v)];
@@ -87,6 +99,7 @@ class ExpressionParser {
     return power();
   }
   int power() {
+    Depth guard(*this);
     const int base = primary();
     if (accept('^')) return binary(Op::Pow, base, unary());
     return base;
@@ -103,17 +116,38 @@ class ExpressionParser {
     }
     if (std::isdigit(static_cast<unsigned char>(c)) || c == '.') return number();
     if (std::isalpha(static_cast<unsigned char>(c)) || c == '_') return name();
-    fail(pos_, std::string("unexpected '") + c + "': expected a number, a name or '('");
+    fail(pos_, "unexpected '" + characterAt(pos_) + "': expected a number, a name or '('");
   }
+  // The whole UTF-8 sequence at i, so a message never prints half a character.
+  std::string characterAt(std::size_t i) const {
+    std::size_t n = 1;
+    while (i + n < s_.size() && (static_cast<unsigned char>(s_[i + n]) & 0xC0) == 0x80) ++n;
+    return s_.substr(i, n);
+  }
+  // digits [. digits] [(e|E) [+-] digits]: scanned here (strtod alone would also take hex,
+  // inf and nan).
   int number() {
     const std::size_t start = pos_;
-    const char* begin = s_.c_str() + pos_;
-    char* end = nullptr;
-    const double v = std::strtod(begin, &end);
-    if (end == begin) fail(start, "malformed number");
-    pos_ += static_cast<std::size_t>(end - begin);
-    if (pos_ < s_.size() && (std::isalpha(static_cast<unsigned char>(s_[pos_])) || s_[pos_] == '_'))
-      fail(pos_, "a number runs into a name: write the operator (e.g. 2*x)");
+    auto digits = [&] {
+      const std::size_t from = pos_;
+      while (pos_ < s_.size() && std::isdigit(static_cast<unsigned char>(s_[pos_]))) ++pos_;
+      return pos_ - from;
+    };
+    std::size_t mantissa = digits();
+    if (pos_ < s_.size() && s_[pos_] == '.') {
+      ++pos_;
+      mantissa += digits();
+    }
+    if (mantissa == 0) fail(start, "malformed number: '.' needs digits");
+    if (pos_ < s_.size() && (s_[pos_] == 'e' || s_[pos_] == 'E')) {
+      const std::size_t e = pos_++;
+      if (pos_ < s_.size() && (s_[pos_] == '+' || s_[pos_] == '-')) ++pos_;
+      if (digits() == 0) fail(e, "malformed number: the exponent needs digits (e.g. 1e-6)");
+    }
+    if (pos_ < s_.size() && (std::isalpha(static_cast<unsigned char>(s_[pos_])) || s_[pos_] == '_' || s_[pos_] == '.'))
+      fail(pos_, "a number runs into '" + characterAt(pos_) + "': write the operator (e.g. 2*x)");
+    const double v = std::strtod(s_.substr(start, pos_ - start).c_str(), nullptr);
+    if (!std::isfinite(v)) fail(start, "number out of range");
     Expression::Node n;
     n.op = Op::Number;
     n.value = v;
@@ -173,6 +207,7 @@ class ExpressionParser {
   const std::vector<std::string>& symbols_;
   Expression& e_;
   std::size_t pos_ = 0;
+  int depth_ = 0;
 };
 
 Expression Expression::parse(const std::string& text, const std::vector<std::string>& symbols) {

@@ -101,6 +101,22 @@ TEST(Expression, ErrorsPointAtTheColumn) {
   EXPECT_EQ(errorColumn("d # 2", s), 3);
   EXPECT_EQ(errorColumn("   ", s), 4);
   EXPECT_EQ(errorColumn("d +", s), 4);
+  EXPECT_EQ(errorColumn("d*0x10", s), 4);      // no hex: '0' runs into 'x'
+  EXPECT_EQ(errorColumn("d*1e999", s, &what), 3);
+  EXPECT_NE(what.find("out of range"), std::string::npos) << what;
+  EXPECT_EQ(errorColumn("d*1e", s, &what), 4);
+  EXPECT_NE(what.find("exponent"), std::string::npos) << what;
+  EXPECT_EQ(errorColumn("1.2.3", s), 4);
+  EXPECT_EQ(errorColumn("d + \xC2\xB5", s, &what), 5);
+  EXPECT_NE(what.find("'\xC2\xB5'"), std::string::npos) << what;  // the whole character
+  // Bounded depth and length: an error, not a stack overflow.
+  EXPECT_GT(errorColumn(std::string(30000, '(') + "d" + std::string(30000, ')'), s, &what), 0);
+  EXPECT_NE(what.find("nested too deeply"), std::string::npos) << what;
+  EXPECT_GT(errorColumn(std::string(50000, '-') + "d", s), 0);
+  std::string chain = "d";
+  for (int i = 0; i < 20000; ++i) chain += "+d";
+  EXPECT_GT(errorColumn(chain, s, &what), 0);
+  EXPECT_NE(what.find("too long"), std::string::npos) << what;
 }
 
 TEST(Expression, UndefinedAtTheEstimateIsRefusedByTheGuf) {

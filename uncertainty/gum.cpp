@@ -1,10 +1,12 @@
 #include "uncertainty/gum.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <boost/math/distributions/normal.hpp>
 #include <boost/math/distributions/students_t.hpp>
 #include <iomanip>
 #include <boost/random/normal_distribution.hpp>
+#include <boost/random/student_t_distribution.hpp>
 #include <boost/random/uniform_01.hpp>
 #include <random>
 #include <sstream>
@@ -102,8 +104,10 @@ double coverageFactor(double p, double dof) {
 }
 
 double numericalTolerance(double u, int nd) {
-  if (!(u > 0)) return 0;
-  const int l = static_cast<int>(std::floor(std::log10(u))) - (nd - 1);
+  if (!(u > 0) || !std::isfinite(u)) return 0;
+  // u = c x 10^l with c an n_dig-digit integer: round first (0.0997 -> 0.10 -> l = -2).
+  int l = static_cast<int>(std::floor(std::log10(u))) - (nd - 1);
+  if (std::llround(u / std::pow(10.0, l)) >= static_cast<long long>(std::pow(10.0, nd))) ++l;
   return 0.5 * std::pow(10.0, l);
 }
 
@@ -163,23 +167,38 @@ GufResult gufFromGradient(const Problem& pr, double y, const std::vector<double>
   r.budget = combine(pr.output, pr.unit, r.y, contributions);
   r.u_c = std::sqrt(std::max(0.0, u2));
   r.budget.u_c = r.u_c;
-  double ws = 0;
-  for (const auto& c : r.budget.contributions)
-    if (std::isfinite(c.dof) && c.u > 0) ws += std::pow(c.u, 4) / c.dof;
-  r.nu_eff = ws > 0 ? std::pow(r.u_c, 4) / ws : std::numeric_limits<double>::infinity();  // G.2b
+  // Welch-Satterthwaite (G.2b) over independent groups: inputs linked by correlations form
+  // one group, whose contribution is c_g^T V_g c_g and whose dof is the smallest of its
+  // members (n - 1 for inputs observed together, Willink 2007); without this G.2b collapses
+  // when u_c is smaller than single contributions (JCGM 100 H.2: nu_eff(R) = 0.12).
+  // Written with (u_g / u_c)^4 so that neither 1e-90 nor 1e80 over- or underflows.
+  std::vector<int> group(static_cast<std::size_t>(n));
+  for (Eigen::Index i = 0; i < n; ++i) group[static_cast<std::size_t>(i)] = static_cast<int>(i);
   if (r.correlated) {
-    // With correlated inputs u_c can be smaller than single contributions and G.2b collapses
-    // (JCGM 100 H.2: nu_eff of R would be 0.12). The usual case is inputs observed together
-    // (n simultaneous observations), for which nu = n - 1 (Willink 2007): nu_eff is not
-    // allowed below the smallest dof of the correlated inputs that contribute.
-    double floor_dof = std::numeric_limits<double>::infinity();
-    for (Eigen::Index i = 0; i < n; ++i) {
-      bool correlated_i = false;
-      for (Eigen::Index j = 0; j < n; ++j) correlated_i = correlated_i || (i != j && pr.correlation(i, j) != 0);
-      if (correlated_i && cu(i) != 0) floor_dof = std::min(floor_dof, pr.inputs[static_cast<std::size_t>(i)].dof);
-    }
-    if (std::isfinite(floor_dof)) r.nu_eff = std::max(r.nu_eff, floor_dof);
+    std::function<int(int)> root = [&](int i) { return group[static_cast<std::size_t>(i)] == i ? i : root(group[static_cast<std::size_t>(i)]); };
+    for (Eigen::Index i = 0; i < n; ++i)
+      for (Eigen::Index j = i + 1; j < n; ++j)
+        if (pr.correlation(i, j) != 0) group[static_cast<std::size_t>(root(static_cast<int>(j)))] = root(static_cast<int>(i));
+    for (Eigen::Index i = 0; i < n; ++i) group[static_cast<std::size_t>(i)] = root(static_cast<int>(i));
   }
+  double ws = 0;
+  if (r.u_c > 0)
+    for (Eigen::Index g = 0; g < n; ++g) {
+      double var = 0, dof = std::numeric_limits<double>::infinity();
+      bool any = false;
+      for (Eigen::Index i = 0; i < n; ++i) {
+        if (group[static_cast<std::size_t>(i)] != g) continue;
+        any = true;
+        if (cu(i) != 0) dof = std::min(dof, pr.inputs[static_cast<std::size_t>(i)].dof);
+        for (Eigen::Index j = 0; j < n; ++j)
+          if (group[static_cast<std::size_t>(j)] == g)
+            var += cu(i) * cu(j) * (r.correlated ? pr.correlation(i, j) : (i == j ? 1.0 : 0.0));
+      }
+      if (!any || !std::isfinite(dof) || var <= 0) continue;
+      const double ratio = std::sqrt(var) / r.u_c;
+      ws += ratio * ratio * ratio * ratio / dof;
+    }
+  r.nu_eff = ws > 0 ? 1.0 / ws : std::numeric_limits<double>::infinity();
   r.budget.nu_eff = r.nu_eff;
   r.k = coverageFactor(p, std::isfinite(r.nu_eff) ? std::max(1.0, std::floor(r.nu_eff)) : r.nu_eff);  // G.6.4
   r.U = r.k * r.u_c;
@@ -202,29 +221,47 @@ std::vector<double> sampleInputs(const Problem& p, long trials, std::uint64_t se
   // with 1e6 trials of 32 inputs the draws dominate the Monte Carlo time.
   boost::random::normal_distribution<double> N(0.0, 1.0);
   boost::random::uniform_01<double> U;
-  const bool corr = p.correlation.size() > 0;
+  // Inputs linked by a correlation are drawn jointly (multivariate normal, JCGM 101 6.4.8);
+  // the others by their own distributions.
+  std::vector<std::size_t> joint;
+  if (p.correlation.size() > 0)
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t j = 0; j < n; ++j)
+        if (i != j && p.correlation(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) != 0) {
+          joint.push_back(i);
+          break;
+        }
+  std::vector<bool> in_joint(n, false);
+  for (std::size_t i : joint) in_joint[i] = true;
   Eigen::MatrixXd L;
-  if (corr) {
-    for (const auto& in : p.inputs)
-      if (in.distribution != Distribution::Normal)
-        throw InputError("", 0, in.name + ": correlated inputs must be normal for the Monte Carlo method (JCGM 101 6.4.8)");
+  if (!joint.empty()) {
+    for (std::size_t i : joint)
+      if (p.inputs[i].distribution != Distribution::Normal)
+        throw InputError("", 0, p.inputs[i].name + ": correlated inputs must be normal for the Monte Carlo method (JCGM 101 6.4.8); "
+                                "give it distribution: normal (for observations: distribution: normal)");
+    const auto k = static_cast<Eigen::Index>(joint.size());
+    Eigen::MatrixXd R(k, k);
+    for (Eigen::Index a = 0; a < k; ++a)
+      for (Eigen::Index b = 0; b < k; ++b)
+        R(a, b) = p.correlation(static_cast<Eigen::Index>(joint[static_cast<std::size_t>(a)]), static_cast<Eigen::Index>(joint[static_cast<std::size_t>(b)]));
     // Positive semidefinite: LDLT, then L sqrt(D).
-    Eigen::LDLT<Eigen::MatrixXd> ldlt(p.correlation);
+    Eigen::LDLT<Eigen::MatrixXd> ldlt(R);
     const Eigen::MatrixXd Lm = ldlt.matrixL();
-    const Eigen::MatrixXd PtL = ldlt.transpositionsP().transpose() * Lm;  // A = PtL D PtL^T
+    const Eigen::MatrixXd PtL = ldlt.transpositionsP().transpose() * Lm;  // R = PtL D PtL^T
     L = PtL * ldlt.vectorD().cwiseMax(0.0).cwiseSqrt().asDiagonal();
   }
   std::vector<double> x(static_cast<std::size_t>(trials) * n);
-  Eigen::VectorXd z(static_cast<Eigen::Index>(n));
+  Eigen::VectorXd z(static_cast<Eigen::Index>(joint.size()));
   for (long t = 0; t < trials; ++t) {
     double* row = &x[static_cast<std::size_t>(t) * n];
-    if (corr) {
-      for (std::size_t i = 0; i < n; ++i) z(static_cast<Eigen::Index>(i)) = N(rng);
+    if (!joint.empty()) {
+      for (Eigen::Index a = 0; a < z.size(); ++a) z(a) = N(rng);
       const Eigen::VectorXd w = L * z;
-      for (std::size_t i = 0; i < n; ++i) row[i] = p.inputs[i].value + p.inputs[i].u * w(static_cast<Eigen::Index>(i));
-      continue;
+      for (std::size_t a = 0; a < joint.size(); ++a)
+        row[joint[a]] = p.inputs[joint[a]].value + p.inputs[joint[a]].u * w(static_cast<Eigen::Index>(a));
     }
     for (std::size_t i = 0; i < n; ++i) {
+      if (in_joint[i]) continue;
       const Input& in = p.inputs[i];
       switch (in.distribution) {
         case Distribution::Normal: row[i] = in.value + in.u * N(rng); break;
@@ -232,14 +269,31 @@ std::vector<double> sampleInputs(const Problem& p, long trials, std::uint64_t se
         case Distribution::Triangular: row[i] = in.value + in.half_width * (U(rng) + U(rng) - 1); break;
         case Distribution::UShaped: row[i] = in.value + in.half_width * std::sin(2 * M_PI * U(rng)); break;
         case Distribution::StudentT: {
-          std::chi_squared_distribution<double> chi(in.dof);
-          row[i] = in.value + in.scale * N(rng) / std::sqrt(chi(rng) / in.dof);
+          // Boost's, not std's: the same draws with every standard library.
+          boost::random::student_t_distribution<double> T(in.dof);
+          row[i] = in.value + in.scale * T(rng);
           break;
         }
       }
     }
   }
   return x;
+}
+
+long minimumTrials(double p) { return std::max(100L, static_cast<long>(std::ceil(10.0 / (1.0 - p)))); }
+
+void checkTrials(const McmOptions& o) {
+  if (!(o.p > 0.5 && o.p <= 0.9999))
+    throw InputError("", 0, "coverage probability " + std::to_string(o.p) + ": the Monte Carlo method here takes p in (0.5, 0.9999]");
+  if (o.fixed_trials > 0 && o.fixed_trials < minimumTrials(o.p))
+    throw InputError("", 0, std::to_string(o.fixed_trials) + " trials are too few for p = " + std::to_string(o.p) +
+                                ": at least " + std::to_string(minimumTrials(o.p)) + " (JCGM 101 7.2.2 recommends 10^4/(1 - p))");
+}
+
+void nonFinite(const std::string& output) {
+  throw GeometryError(output + ": a Monte Carlo trial gave a value that is not finite: the model is not defined over the "
+                               "whole range of its inputs' distributions (e.g. a division by, sqrt or log of a quantity "
+                               "that can reach 0)");
 }
 
 long batchSize(const McmOptions& o) {
@@ -269,6 +323,7 @@ bool stable(const std::vector<McmResult>& batches, int nd) {
 McmResult summarise(std::vector<double>& y, double p) {
   McmResult r;
   const auto M = static_cast<long>(y.size());
+  if (M < 2) throw InputError("", 0, "a Monte Carlo summary needs at least 2 trials");
   r.trials = M;
   double mean = 0;
   for (double v : y) mean += v;
@@ -278,11 +333,13 @@ McmResult summarise(std::vector<double>& y, double p) {
   r.y = mean;
   r.u = M > 1 ? std::sqrt(ss / static_cast<double>(M - 1)) : 0.0;
   std::sort(y.begin(), y.end());
-  // JCGM 101 7.7: q = pM (rounded), r = (M - q) / 2 for the symmetric interval.
+  // JCGM 101 7.7: q = pM rounded; the symmetric interval is [y_(r), y_(r+q)] (1-based) with
+  // r = (M - q)/2 for M - q even and (M - q + 1)/2 otherwise, i.e. r = floor((M - q + 1)/2).
+  // Callers guarantee M >= minimumTrials(p), so 1 <= r and r + q <= M.
   const long q = std::max(1L, std::min(M - 1, static_cast<long>(std::llround(p * static_cast<double>(M)))));
-  const long rs = std::max(0L, (M - q) / 2);
-  r.symmetric_low = y[static_cast<std::size_t>(rs)];
-  r.symmetric_high = y[static_cast<std::size_t>(std::min(M - 1, rs + q))];
+  const long r1 = std::max(1L, (M - q + 1) / 2);
+  r.symmetric_low = y[static_cast<std::size_t>(r1 - 1)];
+  r.symmetric_high = y[static_cast<std::size_t>(std::min(M - 1, r1 - 1 + q))];
   long best = 0;
   for (long k = 0; k + q < M; ++k)
     if (y[static_cast<std::size_t>(k + q)] - y[static_cast<std::size_t>(k)] <

@@ -76,7 +76,7 @@ struct McmOptions {
   double p = 0.95;
   int significant_digits = 2;  // n_dig of JCGM 101 7.9
   long batch = 0;              // 0: max(ceil(100 / (1 - p)), 10^4)
-  long max_trials = 100'000'000;
+  long max_trials = 10'000'000;  // adaptive runs that do not converge stop here (converged = false)
   long fixed_trials = 0;       // > 0: exactly this many (drawn in batches), no adaptive stop
   std::uint64_t seed = 1;
   std::function<void(long done)> progress;  // called after each batch
@@ -117,6 +117,9 @@ McmResult summarise(std::vector<double>& y, double p);
 // ends is within the numerical tolerance of u (needs >= 2 batches).
 bool stable(const std::vector<McmResult>& batches, int significant_digits);
 long batchSize(const McmOptions& o);
+long minimumTrials(double p);          // below this the 7.7 intervals are not defined
+void checkTrials(const McmOptions& o);  // p and fixed_trials: InputError
+[[noreturn]] void nonFinite(const std::string& output);
 }  // namespace detail
 
 // The GUF from a model's value and gradient at the estimate (models whose number of inputs
@@ -141,6 +144,7 @@ GufResult propagate(const Problem& pr, const Model& f, double p = 0.95) {
 template <class Model>
 McmResult monteCarlo(const Problem& pr, const Model& f, const McmOptions& o = {}) {
   pr.check();
+  detail::checkTrials(o);
   const std::size_t n = pr.inputs.size();
   const long batch = detail::batchSize(o);
   const long limit = o.fixed_trials > 0 ? o.fixed_trials : o.max_trials;
@@ -151,7 +155,10 @@ McmResult monteCarlo(const Problem& pr, const Model& f, const McmOptions& o = {}
     const long b = std::min(batch, limit - done);
     const std::vector<double> x = detail::sampleInputs(pr, b, o.seed, done);
     std::vector<double> y(static_cast<std::size_t>(b));
-    for (long t = 0; t < b; ++t) y[static_cast<std::size_t>(t)] = f(&x[static_cast<std::size_t>(t) * n]);
+    for (long t = 0; t < b; ++t) {
+      y[static_cast<std::size_t>(t)] = f(&x[static_cast<std::size_t>(t) * n]);
+      if (!std::isfinite(y[static_cast<std::size_t>(t)])) detail::nonFinite(pr.output);
+    }
     all.insert(all.end(), y.begin(), y.end());
     done += b;
     if (o.progress) o.progress(done);
@@ -162,8 +169,6 @@ McmResult monteCarlo(const Problem& pr, const Model& f, const McmOptions& o = {}
       break;
     }
   }
-  for (double v : all)
-    if (!std::isfinite(v)) detail::undefinedAtEstimate(pr.output + " (a Monte Carlo trial)");
   const bool converged = out.converged;
   out = detail::summarise(all, o.p);
   out.converged = converged;

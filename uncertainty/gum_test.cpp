@@ -290,6 +290,60 @@ TEST(Gum, StudentTInputUsesTheStandardDeviationOfTheMeanInTheGuf) {
   EXPECT_NEAR(m.symmetric_high - 20, 2.776, 0.03);  // the t interval: GUF and MCM agree
 }
 
+// Welch-Satterthwaite over groups: a correlated pair that contributes little must not lift
+// nu_eff when an uncorrelated input with nu = 2 dominates; and G.2b must not overflow.
+TEST(Gum, EffectiveDofGroupsCorrelatedInputsAndIsScaleSafe) {
+  Problem pr;
+  pr.output = "Y";
+  pr.inputs = {Input::normal("a", 0, 0.01, 100), Input::normal("b", 0, 0.01, 100), Input::normal("c", 0, 1, 2)};
+  pr.correlation = (Eigen::Matrix3d() << 1, 0.5, 0, 0.5, 1, 0, 0, 0, 1).finished();
+  const auto g = propagate<3>(pr, [](const auto* x) { return x[0] + x[1] + x[2]; });
+  // Groups: {a, b} with u_g^2 = 3e-4 (r = 0.5), nu = 100; {c}: 1, nu = 2.
+  const double u2 = 3e-4 + 1;
+  EXPECT_NEAR(g.nu_eff, 1 / ((3e-4 / u2) * (3e-4 / u2) / 100 + (1 / u2) * (1 / u2) / 2), 1e-9);
+  EXPECT_LT(g.nu_eff, 2.01);
+  Problem big;
+  big.output = "Y";
+  big.inputs = {Input::normal("x", 0, 1e80, 10)};
+  EXPECT_NEAR(propagate<1>(big, [](const auto* x) { return x[0]; }).nu_eff, 10, 1e-9);
+  big.inputs = {Input::normal("x", 0, 1e-90, 3)};
+  EXPECT_NEAR(propagate<1>(big, [](const auto* x) { return x[0]; }).k, 3.182, 0.001);
+}
+
+// JCGM 101 7.7.1: [y_(r), y_(r+q)] with q = pM and r = (M - q)/2 (even) or (M - q + 1)/2.
+TEST(Gum, SymmetricIntervalIndicesOfJcgm101) {
+  std::vector<double> y;
+  for (int i = 10; i >= 1; --i) y.push_back(i);
+  auto even = y;  // p = 0.8: q = 8, M - q = 2, r = 1: [y_(1), y_(9)]
+  const auto a = detail::summarise(even, 0.8);
+  EXPECT_EQ(a.symmetric_low, 1);
+  EXPECT_EQ(a.symmetric_high, 9);
+  auto odd = y;  // p = 0.7: q = 7, M - q = 3, r = 2: [y_(2), y_(9)]
+  const auto b = detail::summarise(odd, 0.7);
+  EXPECT_EQ(b.symmetric_low, 2);
+  EXPECT_EQ(b.symmetric_high, 9);
+  EXPECT_EQ(b.shortest_high - b.shortest_low, 7);  // any 8 consecutive of 1..10
+  // 7.9.2: u = 0.0997 is 0.10 to two digits: c = 10, l = -2, delta = 0.005.
+  EXPECT_DOUBLE_EQ(numericalTolerance(0.0997, 2), 0.005);
+  EXPECT_DOUBLE_EQ(numericalTolerance(0.0994, 2), 0.0005);
+  McmOptions o;
+  o.fixed_trials = 10;
+  Problem pr;
+  pr.output = "Y";
+  pr.inputs = {Input::normal("X", 0, 1)};
+  EXPECT_THROW(monteCarlo(pr, [](const auto* x) { return x[0]; }, o), InputError);  // too few for p = 0.95
+}
+
+// Only the correlated inputs need to be normal; the others keep their distributions.
+TEST(Gum, CorrelatedNormalsBesideAnUncorrelatedRectangular) {
+  Problem pr;
+  pr.output = "Y";
+  pr.inputs = {Input::normal("a", 0, 1), Input::normal("b", 0, 1), Input::rectangular("c", 0, std::sqrt(3.0))};
+  pr.correlation = (Eigen::Matrix3d() << 1, 0.5, 0, 0.5, 1, 0, 0, 0, 1).finished();
+  const auto m = monteCarlo(pr, [](const auto* x) { return x[0] + x[1] + x[2]; });
+  EXPECT_NEAR(m.u, 2.0, 0.02);  // 1 + 1 + 2 r + 1 = 4
+}
+
 TEST(Gum, SameSeedSameResult) {
   Problem pr;
   pr.output = "Y";

@@ -41,6 +41,11 @@ TextModelResult evaluateTextModel(const TextModel& m, const std::optional<McmOpt
   // One draw of the inputs serves every output; the adaptive stop waits for all of them.
   McmOptions o = *options;
   o.p = m.p;
+  try {
+    detail::checkTrials(o);
+  } catch (const InputError& e) {
+    throw InputError(m.file, 0, e.what());
+  }
   const long batch = detail::batchSize(o);
   const long limit = o.fixed_trials > 0 ? o.fixed_trials : o.max_trials;
   std::vector<std::vector<double>> all(m.outputs.size());
@@ -49,16 +54,23 @@ TextModelResult evaluateTextModel(const TextModel& m, const std::optional<McmOpt
   long done = 0;
   while (done < limit) {
     const long b = std::min(batch, limit - done);
-    const std::vector<double> x = detail::sampleInputs(m.inputs, b, o.seed, done);
+    std::vector<double> x;
+    try {
+      x = detail::sampleInputs(m.inputs, b, o.seed, done);
+    } catch (const InputError& e) {
+      throw InputError(m.file, 0, e.what());
+    }
     bool all_stable = true;
     for (std::size_t j = 0; j < m.outputs.size(); ++j) {
       std::vector<double> y(static_cast<std::size_t>(b));
       for (long t = 0; t < b; ++t) {
         y[static_cast<std::size_t>(t)] = m.outputs[j].model.evaluate(&x[static_cast<std::size_t>(t) * n]);
         if (!std::isfinite(y[static_cast<std::size_t>(t)]))
-          throw InputError(m.file, m.outputs[j].line, "outputs." + m.outputs[j].name + ".model: a Monte Carlo trial gave a value that is not finite (the model "
-                              "is not defined over the whole range of its inputs' distributions, e.g. sqrt or log "
-                              "of a quantity that can reach 0)");
+          try {
+            detail::nonFinite(m.outputs[j].name);
+          } catch (const GeometryError& e) {
+            throw InputError(m.file, m.outputs[j].line, std::string("outputs.") + e.what());
+          }
       }
       all[j].insert(all[j].end(), y.begin(), y.end());
       if (o.fixed_trials == 0) {
@@ -74,6 +86,7 @@ TextModelResult evaluateTextModel(const TextModel& m, const std::optional<McmOpt
     }
   }
   r.mcm_trials = done;
+  r.mcm_adaptive = o.fixed_trials == 0;
   r.mcm_converged = converged;
   for (std::size_t j = 0; j < m.outputs.size(); ++j) {
     McmResult mr = detail::summarise(all[j], o.p);
@@ -132,14 +145,16 @@ std::string textModelReport(const TextModel& m, const TextModelResult& r) {
     if (res.mcm) {
       const auto& mc = *res.mcm;
       const auto& v = *res.validation;
-      o << "  Monte Carlo (JCGM 101), " << mc.trials << " trials" << (mc.converged ? " (adaptive stop reached)" : "")
+      o << "  Monte Carlo (JCGM 101), " << mc.trials << " trials"
+        << (mc.converged ? " (adaptive stop reached)" : r.mcm_adaptive ? " (adaptive stop NOT reached: the results are not stable to the requested digits; the model may have a pole or an infinite variance)" : " (fixed)")
         << ": y = " << g(mc.y, 10) << "  u = " << g(mc.u, 4) << "\n";
       o << "    probabilistically symmetric interval [" << g(mc.symmetric_low, 8) << ", " << g(mc.symmetric_high, 8)
         << "], shortest [" << g(mc.shortest_low, 8) << ", " << g(mc.shortest_high, 8) << "]\n";
       o << "    validation of the GUF (JCGM 101 8): d_low = " << g(v.d_low, 3) << ", d_high = " << g(v.d_high, 3)
         << ", delta = " << g(v.delta, 3) << ": "
-        << (v.validated ? "the GUF is validated; its interval may be used"
-                        : "the GUF is NOT validated; report the Monte Carlo interval")
+        << (!mc.converged && r.mcm_adaptive ? "no verdict: the Monte Carlo run did not converge"
+            : v.validated                  ? "the GUF is validated; its interval may be used"
+                                           : "the GUF is NOT validated; report the Monte Carlo interval")
         << "\n";
     }
   }

@@ -44,6 +44,7 @@ struct TextModelResult {
   Eigen::MatrixXd correlation;  // outputs x outputs (GUF)
   long mcm_trials = 0;
   bool mcm_converged = false;
+  bool mcm_adaptive = false;
 };
 
 // options: nullopt = GUF only. Adaptive MCM stops when every output has converged.

@@ -67,6 +67,9 @@ else:
 p2, j2 = gum(os.path.join(EX, "mass_calibration_9_3.yaml"), "--mcm", "--trials", "50000", "--seed", "7")
 p3, j3 = gum(os.path.join(EX, "mass_calibration_9_3.yaml"), "--mcm", "--trials", "50000", "--seed", "7")
 check("same seed, byte-identical JSON", j2 is not None and j2 == j3)
+p4 = subprocess.run([PL, "gum", os.path.join(EX, "mass_calibration_9_3.yaml"), "--trials", "50"], capture_output=True, text=True)
+check("too few trials for p are refused with the file", p4.returncode != 0 and "too few" in p4.stderr
+      and "mass_calibration_9_3.yaml" in p4.stderr, p4.stderr)
 
 # --- bad models: where, what, nothing written ---------------------------------------------
 base = open(os.path.join(EX, "end_gauge_h1.yaml")).read()
@@ -84,6 +87,11 @@ cases = [
     ("correlation with an unknown input", base + "correlations:\n  - [l_s, q, 0.5]\n", ["unknown input 'q'"]),
     ("undefined derivative at the estimate", base.replace('model: "l_s + d', 'model: "sqrt(dalpha) + l_s + d'),
      ["not defined", "outputs.l.model"]),
+    ("correlation given twice", base + "correlations:\n  - [l_s, d, 0.5]\n  - [d, l_s, -0.5]\n", ["given twice"]),
+    ("correlation entry of the wrong shape", base + "correlations:\n  - [[l_s], d, 0.5]\n", ["[input, input, r]"]),
+    ("output defined twice", base + "  - {name: l, unit: mm, model: \"l_s\"}\n", ["defined twice"]),
+    ("error inside a block-scalar model", base.replace('model: "l_s + d - l_s*(dalpha*theta + alpha_s*dtheta)"',
+     'model: |\n      l_s + d\n        - l_s*(dalpha*thetta + alpha_s*dtheta)'), ["unknown name 'thetta'", "line 2 of the expression"]),
     ("observations without scatter", base.replace("value: -0.1, unit: K, distribution: normal, u: 0.41",
      "observations: [1, 1, 1, 1], unit: K"), ["all observations are equal"]),
 ]
