@@ -7,10 +7,13 @@ $PROBELOOP (the binary) and $PROBELOOP_SOURCE_DIR; plain python3, no numpy.
 """
 import json, math, os, random, struct, subprocess, sys, tempfile
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402
+
 PL = os.environ["PROBELOOP"]
 SRC = os.environ["PROBELOOP_SOURCE_DIR"]
 W = tempfile.mkdtemp(prefix="probeloop-fit-")
-passed, failed = 0, 0
+check = Checks()
 
 
 def run(*args):
@@ -18,14 +21,6 @@ def run(*args):
     return p.returncode, p.stdout, p.stderr
 
 
-def check(name, cond, detail=""):
-    global passed, failed
-    if cond:
-        passed += 1
-        print("ok   " + name)
-    else:
-        failed += 1
-        print("FAIL " + name + ("\n     " + str(detail)[:600] if detail else ""))
 
 
 def fit_json(*args):
@@ -224,5 +219,4 @@ check("a failed fit writes no report", not os.path.exists(out_json))
 rc, _, _ = run("plane", plane, "--out", os.path.join(W, "plane.json"))
 check("--out writes the JSON report", rc == 0 and json.load(open(os.path.join(W, "plane.json")))["element"] == "plane")
 
-print(f"{passed} passed, {failed} failed")
-sys.exit(1 if failed else 0)
+check.finish()

@@ -5,23 +5,18 @@ The reference values are the published ones (JCGM 100 H.1 and H.2, JCGM 101 9.3)
 code's own output. Bad models must fail with a message that says where, and write nothing.
 Needs $PROBELOOP and $PROBELOOP_SOURCE_DIR; plain python3.
 """
-import json, os, subprocess, tempfile
+import json, os, subprocess, sys, tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402
 
 PL = os.environ["PROBELOOP"]
 SRC = os.environ["PROBELOOP_SOURCE_DIR"]
 EX = os.path.join(SRC, "examples", "gum")
 W = tempfile.mkdtemp(prefix="probeloop-gum-")
-passed, failed = 0, 0
+check = Checks()
 
 
-def check(name, cond, detail=""):
-    global passed, failed
-    if cond:
-        passed += 1
-        print("ok   " + name)
-    else:
-        failed += 1
-        print("FAIL " + name + ("\n     " + str(detail)[:800] if detail else ""))
 
 
 def gum(model, *args):
@@ -104,5 +99,4 @@ for name, text, needles in cases:
     check("refuses: " + name, p.returncode != 0 and all(n in msg for n in needles) and not os.path.exists(out)
           and "bad.yaml" in msg, msg)
 
-print(f"{passed} passed, {failed} failed")
-raise SystemExit(1 if failed else 0)
+check.finish()
