@@ -153,6 +153,32 @@ std::array<uncertainty::Budget, 7> locationErrorBudgets(const LocationLeastSquar
   return out;
 }
 
+std::array<uncertainty::Budget, 3> sphereCentreBudgets(const parts::PlanManifest& m, const Eigen::Vector3d& centre,
+                                                       const Eigen::Matrix3d& cov, const PointScatter& ps, double k) {
+  std::array<uncertainty::Budget, 3> out;
+  const bool use_a = ps.type_a_sigma_mm > ps.type_b_sigma_mm && ps.type_a_dof > 0;
+  const char* axis[3] = {"x", "y", "z"};
+  for (int a = 0; a < 3; ++a) {
+    const double s = std::sqrt(std::max(cov(a, a), 0.0)) * 1e3;  // um per mm of point sigma
+    std::vector<Contribution> cs;
+    if (use_a)
+      cs.push_back({"probe point scatter (type A)", 'A', "normal", "pooled free-radius fit residual s = " + num(ps.type_a_sigma_mm * 1e3) + " um",
+                    ps.type_a_sigma_mm * s, ps.type_a_dof});
+    else
+      cs.push_back({"probe repeatability (specification)", 'B', "normal", "probe.repeatability_2sigma = " + num(m.probe_repeatability_2sigma_um) + " um",
+                    ps.type_b_sigma_mm * s, std::numeric_limits<double>::infinity()});
+    cs.push_back({"coordinate resolution", 'B', "rectangular", "q = " + num(m.coordinate_resolution_mm * 1e3) + " um, q/sqrt(12)",
+                  m.coordinate_resolution_mm / std::sqrt(12.0) * s, std::numeric_limits<double>::infinity()});
+    cs.push_back({"sphere form error", 'B', "rectangular", "form " + num(m.sphere_form_error_um) + " um: points within +-form/2",
+                  m.sphere_form_error_um * 1e-3 / 2 / std::sqrt(3.0) * s, std::numeric_limits<double>::infinity()});
+    if (m.tool_change_each_cycle && std::isfinite(m.probe_tool_change_repeatability_2sigma_um))
+      cs.push_back({"tool-change repeatability", 'B', "normal", "probe.tool_change_repeatability_2sigma = " + num(m.probe_tool_change_repeatability_2sigma_um) + " um",
+                    m.probe_tool_change_repeatability_2sigma_um / 2, std::numeric_limits<double>::infinity()});
+    out[static_cast<std::size_t>(a)] = uncertainty::combine(std::string("centre ") + axis[a], "um", centre(a) * 1e3, cs, k);
+  }
+  return out;
+}
+
 std::array<uncertainty::Budget, 7> predictLocationErrorBudgets(const parts::PlanManifest& m, double k) {
   std::vector<double> angles;
   std::vector<int> positions;

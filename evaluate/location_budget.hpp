@@ -52,6 +52,13 @@ std::array<uncertainty::Budget, 7> locationErrorBudgets(const LocationLeastSquar
                                                         const std::array<double, 7>& values, const PointScatter& scatter,
                                                         double k, bool predicted = false);
 
+// The budget of one sphere centre (x, y, z in um, value = centre in um): point scatter,
+// resolution and form error through the fit's (J^T J)^-1, and the tool change. Unlike the
+// location errors (differences of cycles), the form error does not cancel here.
+std::array<uncertainty::Budget, 3> sphereCentreBudgets(const parts::PlanManifest& m, const Eigen::Vector3d& centre_mm,
+                                                       const Eigen::Matrix3d& cov_unscaled, const PointScatter& scatter,
+                                                       double k = 2.0);
+
 // The planner's prediction: both cycles as planned (nominal points, planned times), the
 // specification's scatter. The d/2 term scales with the measured value and drift needs
 // measured cycles: both are listed, with 0, saying so.

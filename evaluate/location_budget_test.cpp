@@ -150,6 +150,25 @@ TEST(LocationBudget, PlannerPredictsFromTheNominalPoints) {
   EXPECT_NEAR(b[2].u_c, 0.5 * 1.0 / 2 * std::sqrt(2.0), 1e-9);  // EZ0T: mean of 4 z, var 1 each
 }
 
+TEST(LocationBudget, SphereCentreCarriesScatterResolutionFormAndToolChange) {
+  auto m = thesis();
+  m.probe_repeatability_2sigma_um = 1.0;
+  m.coordinate_resolution_mm = 0.001;
+  m.sphere_form_error_um = 0.4;
+  m.tool_change_each_cycle = true;
+  m.probe_tool_change_repeatability_2sigma_um = 1.5;
+  evaluate::PointScatter ps;
+  ps.type_b_sigma_mm = 0.5e-3;
+  const Eigen::Matrix3d cov = Eigen::Vector3d(0.5, 0.5, 1.0).asDiagonal();  // 4 equator points + top
+  const auto b = evaluate::sphereCentreBudgets(m, {1, 2, 3}, cov, ps);
+  // per point: 0.5 (probe), 1/sqrt 12 (resolution), 0.2/sqrt 3 (form) um, through sqrt(cov);
+  // the tool change moves the centre by 0.75 um per axis.
+  const double per_point2 = 0.25 + 1.0 / 12 + 0.04 / 3;
+  EXPECT_NEAR(b[0].u_c, std::sqrt(per_point2 * 0.5 + 0.75 * 0.75), 1e-12);
+  EXPECT_NEAR(b[2].u_c, std::sqrt(per_point2 * 1.0 + 0.75 * 0.75), 1e-12);
+  EXPECT_DOUBLE_EQ(b[1].value, 2000);
+}
+
 // Seed 004 Table 5.3: the 3D line is the root-sum-square of X, Y, Z: 2.2 um without and
 // 2.6 um with tool changes.
 TEST(CentreRepeatability, ReproducesTable53RootSumSquare) {

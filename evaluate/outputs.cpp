@@ -101,6 +101,14 @@ std::string evaluationJson(const CampaignEvaluation& e, const parts::PlanManifes
       js["points"] = s.points;
       js["centre_used"] = s.use_free_radius ? "free_radius" : "known_radius";
       js["centre_mm"] = vec(s.centre_mm());
+      js["centre_U_um"] = {s.centre_budgets[0].U, s.centre_budgets[1].U, s.centre_budgets[2].U};
+      for (const auto& b : s.centre_budgets) {
+        ordered_json jb = {{"quantity", b.quantity}, {"unit", b.unit}, {"u_c", b.u_c}, {"nu_eff", finiteOrNull(b.nu_eff)}, {"k", b.k}, {"U", b.U}};
+        for (const auto& ct : b.contributions)
+          jb["contributions"].push_back({{"input", ct.input}, {"type", std::string(1, ct.type)}, {"distribution", ct.distribution},
+                                         {"basis", ct.basis}, {"u", ct.u}});
+        js["centre_budgets"].push_back(jb);
+      }
       js["known_radius_mm"] = s.known_radius.radius_mm;
       js["known_radius_rms_um"] = s.known_radius.rms_mm * 1e3;
       if (s.free_radius) {

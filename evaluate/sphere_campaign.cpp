@@ -150,6 +150,8 @@ CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& m,
   }
 
   for (auto& c : out.cycles) {
+    for (auto& s : c.spheres)
+      s.centre_budgets = sphereCentreBudgets(m, s.centre_mm(), s.centre_cov_unscaled(), out.point_scatter, opt.coverage_k);
     const auto centres = centresOf(c, layout.ls_positions);
     c.least_squares = ls.solve(centres, ref_centres);
     const auto res = ls.residual(centres, ref_centres);

@@ -36,6 +36,7 @@ struct SphereMeasurement {
   int position = 0;
   int points = 0;
   double time_s = 0;  // mean (logged or planned) time of its points
+  std::array<uncertainty::Budget, 3> centre_budgets;  // x, y, z of the centre used (um)
   geometry::SphereFit known_radius;       // radius fixed to R_sphere + r_tip
   std::optional<geometry::SphereFit> free_radius;  // absent when not determinable
   std::string free_radius_note;
