@@ -26,6 +26,8 @@ echo
 echo "== 3. evaluate: the Fanuc DPRNT log -> location errors with U (k=2) =="
 $PL evaluate "$OUT/run/dprnt.txt" --format fanuc --manifest "$OUT/plan/plan.json" \
   --out "$OUT/eval" --scene "$OUT/eval/campaign.gltf"
+echo "   Uncertainty budgets (out/demo/eval/report.md; every term in docs/uncertainty.md):"
+awk '/^## Range of U/{on=1; next} /^## /{on=0} on && NF' "$OUT/eval/report.md" | sed 's/^/   /'
 echo
 echo "== 4. compare with the injected truth (truth.json: what the simulator put in) =="
 python3 tests/integration/compare_errors.py "$OUT/eval/errors.csv" "$OUT/run/truth.json" 0 0 --coverage
@@ -38,4 +40,4 @@ $PL fit plane "$OUT/machining/cmm_export.csv" --feature WALL_X | sed -n '1,2p;9p
 echo "   (the top is faced deep by the spindle's growth; the wall stands proud by the tool's deflection: cuts.json)"
 echo
 echo "Outputs: $OUT/plan (G-code, manifest), $OUT/run (controller log, points.csv, inputs.csv, truth.json),"
-echo "         $OUT/eval (errors.csv, evaluation.json, campaign.gltf), $OUT/machining (cuts.json, cmm_export.csv)"
+echo "         $OUT/eval (errors.csv, evaluation.json, report.md, campaign.gltf), $OUT/machining (cuts.json, cmm_export.csv)"
