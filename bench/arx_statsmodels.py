@@ -16,8 +16,11 @@ cols = {}
 for i in range(r):
     for lag in range(3):
         cols[f"b[u{i + 1}][lag {lag}]"] = data[f"u{i + 1}"].shift(lag)
-exog = pd.DataFrame(cols).iloc[2:].reset_index(drop=True)
-endog = data["y"].iloc[2:].reset_index(drop=True)
+# Rows k = 2 .. N-1 as in probeloop (the first two samples are history for lag 2): AutoReg
+# holds back its first row (lag 1), so the series start at k = 1; that row's lag-2 input is
+# unknown and only held back, so it is filled with 0.
+exog = pd.DataFrame(cols).iloc[1:].fillna(0.0).reset_index(drop=True)
+endog = data["y"].iloc[1:].reset_index(drop=True)
 times = []
 for _ in range(reps):
     t0 = time.perf_counter()
