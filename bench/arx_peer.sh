@@ -3,19 +3,9 @@
 # (issue 5 item 8): probeloop's fitArx and statsmodels' AutoReg; writes bench/results/arx.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-packages=(cmake g++ make python3-statsmodels python3-pandas)
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-fi
-BUILD=build-bench
-cmake -S . -B $BUILD -DCMAKE_BUILD_TYPE=Release -DPROBELOOP_BENCH=ON >/dev/null
-cmake --build $BUILD --target probeloop_bench_arx -j2 >/dev/null
+. bench/common.sh
+ensure_packages cmake g++ make python3-statsmodels python3-pandas
+build_bench_target probeloop_bench_arx
 mkdir -p bench/results
 $BUILD/bench/probeloop_bench_arx bench/results/arx_data.csv > bench/results/arx_ours.json
 /usr/bin/python3 bench/arx_statsmodels.py bench/results/arx_data.csv > bench/results/arx_statsmodels.json

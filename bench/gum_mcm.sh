@@ -4,19 +4,9 @@
 # same model in the same run; writes bench/results/gum.md.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-packages=(cmake g++ make libbenchmark-dev python3-numpy libceres-dev libboost-dev)
-missing=()
-for p in "${packages[@]}"; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [ ${#missing[@]} -gt 0 ]; then
-  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
-  $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-fi
-BUILD=build-bench
-cmake -S . -B $BUILD -DCMAKE_BUILD_TYPE=Release -DPROBELOOP_BENCH=ON >/dev/null
-cmake --build $BUILD --target probeloop_bench_gum -j2 >/dev/null
+. bench/common.sh
+ensure_packages cmake g++ make libbenchmark-dev python3-numpy libceres-dev libboost-dev
+build_bench_target probeloop_bench_gum
 mkdir -p bench/results
 $BUILD/bench/probeloop_bench_gum --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
   --benchmark_format=json > bench/results/gum_ours.json
