@@ -203,7 +203,6 @@ std::array<uncertainty::Budget, 7> predictLocationErrorBudgets(const parts::Plan
     fo.fixed_radius_mm = m.sphere_radius_mm + m.tip_radius_mm;
     const auto fit = geometry::fitSphere(pts, fo);
     planned.centre_cov_unscaled.push_back(fit.covariance_unscaled.topLeftCorner<3, 3>());
-    planned.points.push_back(per);
     planned.tau_s.push_back(t / per - t_mean);
   }
   PointScatter ps;

@@ -33,7 +33,6 @@ namespace probeloop::evaluate {
 
 struct CycleBudgetInput {
   std::vector<Eigen::Matrix3d> centre_cov_unscaled;  // per least-squares position, from the fit
-  std::vector<int> points;                           // points per position
   std::vector<double> tau_s;                         // mean time of the position - cycle mean time
   std::array<double, 7> rate_per_s{};                // d(error)/dt, error unit per s
   bool rate_known = false;

@@ -37,7 +37,7 @@ evaluate::LocationLeastSquares estimator() { return evaluate::LocationLeastSquar
 
 CycleBudgetInput quietCycle() {
   CycleBudgetInput c;
-  for (int k = 0; k < 4; ++k) c.centre_cov_unscaled.push_back(Eigen::Matrix3d::Zero()), c.points.push_back(5), c.tau_s.push_back(0);
+  for (int k = 0; k < 4; ++k) c.centre_cov_unscaled.push_back(Eigen::Matrix3d::Zero()), c.tau_s.push_back(0);
   return c;
 }
 

@@ -182,7 +182,6 @@ CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& m,
     for (int p : layout.ls_positions) {
       const auto& s = c.spheres[static_cast<std::size_t>(p - 1)];
       in.centre_cov_unscaled.push_back(s.centre_cov_unscaled());
-      in.points.push_back(s.points);
       in.tau_s.push_back(s.time_s - c.time_s);
     }
     if (n_cycles >= 2) {

@@ -237,13 +237,4 @@ double Expression::gradient(const double* x, std::vector<double>& dydx) const {
   return y;
 }
 
-std::vector<bool> Expression::uses() const {
-  int n = 0;
-  for (const auto& node : nodes_) n = std::max(n, node.symbol + 1);
-  std::vector<bool> u(static_cast<std::size_t>(n), false);
-  for (const auto& node : nodes_)
-    if (node.op == Op::Symbol) u[static_cast<std::size_t>(node.symbol)] = true;
-  return u;
-}
-
 }  // namespace probeloop::uncertainty

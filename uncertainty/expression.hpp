@@ -43,8 +43,6 @@ class Expression {
   double gradient(const double* x, std::vector<double>& dydx) const;
 
   const std::string& text() const { return text_; }
-  // Which inputs the expression uses (by index).
-  std::vector<bool> uses() const;
 
  private:
   enum class Op { Number, Symbol, Neg, Add, Sub, Mul, Div, Pow, Call1, Call2 };
