@@ -8,6 +8,7 @@
 #include <sstream>
 #include <unistd.h>
 
+#include "cli/model_commands.hpp"
 #include "core/atomic_file.hpp"
 #include "core/csv.hpp"
 #include "core/error.hpp"
@@ -365,8 +366,12 @@ int main(int argc, char** argv) {
   gum->add_option("--seed", seed, "random seed")->capture_default_str();
   gum->add_option("--json", gum_json, "also write the results as JSON to this file");
 
+  CLI::App* model_group = nullptr;
+  const auto run_model = cli::addModelCommands(app, model_group);
+
   CLI11_PARSE(app, argc, argv);
   try {
+    if (*model_group) return run_model();
     if (*plan) return cmdPlan(artifact, machine, out, dialect);
     if (*res) return cmdResolution(artifact, machine, step_um);
     if (*syn) return cmdSynth(manifest, truth, out, seed);

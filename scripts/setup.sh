@@ -5,7 +5,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(cmake g++ make python3 libeigen3-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
-          libtinygltf-dev libgtest-dev libcgal-dev libgmp-dev libmpfr-dev libceres-dev libboost-dev linuxcnc-uspace)
+          libtinygltf-dev libgtest-dev libcgal-dev libgmp-dev libmpfr-dev libceres-dev libboost-dev linuxcnc-uspace
+          libjs-vega chromium)
 command -v node >/dev/null 2>&1 || packages+=(nodejs)
 command -v npm >/dev/null 2>&1 || packages+=(npm)
 

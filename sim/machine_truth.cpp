@@ -222,6 +222,11 @@ MachineTruth loadMachineTruth(const std::string& path) {
         t.duty.mwf_profile.push_back({p.quantity("at", Dimension::Duration), p.boolean("on")});
         p.finish();
       }
+    if (auto c = d->mapIfPresent("tool_changes")) {
+      t.duty.tool_changes_per_hour = c->number("per_hour");
+      if (!(t.duty.tool_changes_per_hour > 0)) c->fail("per_hour", "must be positive (leave tool_changes out for none)");
+      c->finish();
+    }
     d->finish();
   }
   if (auto p = root.mapIfPresent("probe")) {
@@ -240,8 +245,14 @@ MachineTruth loadMachineTruth(const std::string& path) {
     p->finish();
   }
   if (auto c = root.mapIfPresent("tool_change")) {
-    t.atc_repeatability_um = c->quantity("repeatability", Dimension::Micrometre);
+    t.atc_repeatability_um = c->quantityOr("repeatability", Dimension::Micrometre, 0);
     if (t.atc_repeatability_um < 0) c->fail("repeatability", "must not be negative");
+    if (auto s = c->mapIfPresent("settling")) {
+      t.settling_tool_Z_um = s->quantity("tool_Z", Dimension::Micrometre);
+      t.settling_tau_s = s->quantity("time_constant", Dimension::Duration);
+      if (!(t.settling_tau_s > 0)) s->fail("time_constant", "must be positive");
+      s->finish();
+    }
     c->finish();
   }
   if (auto a = root.mapIfPresent("artifact")) {

@@ -87,6 +87,10 @@ struct DutyTruth {
   double hold_s = 0;
   std::vector<std::pair<double, double>> c_profile;  // explicit (time_s, rpm) steps
   std::vector<std::pair<double, bool>> mwf_profile;  // (time_s, on)
+  // Production work with other tools while the probe waits: the probe leaves and is
+  // re-seated at seeded random times (a Poisson process on the dwell clock, so the rate is
+  // per hour of dwelling), which puts tool changes at times unrelated to the probing.
+  double tool_changes_per_hour = 0;
 };
 
 struct ProbeTruth {
@@ -116,6 +120,9 @@ struct MachineTruth {
   DutyTruth duty;
   ProbeTruth probe;
   double atc_repeatability_um = 0;  // 1 sigma per axis of the tip after each tool change
+  // Settling after a tool change: the seated holder and the spindle nose exchange heat, and
+  // the tip moves along Z by settling_tool_Z_um, decaying with settling_tau_s (0 = off).
+  double settling_tool_Z_um = 0, settling_tau_s = 0;
   ArtifactTruth artifact;
   double inputs_rate_s = 60;        // inputs CSV sample period
   // Static stiffness of the structure at the tool (seed 003: F/k), N/um per machine axis;

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
@@ -13,6 +14,7 @@
 #include "core/error.hpp"
 #include "core/units.hpp"
 #include "gcode/probe_log.hpp"
+#include "model/effects.hpp"
 #include "sim/material_removal.hpp"
 
 namespace probeloop::sim {
@@ -69,6 +71,7 @@ struct ProbeEvent {
   std::array<double, 7> location{};  // table-side location errors at the event
   Vector3d tool_um = Vector3d::Zero();  // tool-side translation (thermal + static + ATC)
   Vector3d atc_um = Vector3d::Zero();
+  double settling_um = 0;  // tool-change settling along Z (part of tool_um)
   double artifact_dT_K = 0;
   std::array<double, 7> apparent{};  // what a sphere evaluation sees (docs/simulator.md)
   double pretravel_um = 0, noise_um = 0;
@@ -80,7 +83,8 @@ class VirtualMachine : public gcode::MachineInterface {
   VirtualMachine(const parts::Machine& m, const SimulationPart& part, const MachineTruth& tr,
                  std::uint64_t seed)
       : m_(m), a_(part.artifact), w_(part.workpiece), tr_(tr), noise_rng_(streamSeed(seed, 1)), atc_rng_(streamSeed(seed, 2)),
-        sensor_rng_(streamSeed(seed, 3)), duty_rng_(streamSeed(seed, 4)) {
+        sensor_rng_(streamSeed(seed, 3)), duty_rng_(streamSeed(seed, 4)), duty_tc_rng_(streamSeed(seed, 5)),
+        duty_atc_rng_(streamSeed(seed, 6)) {
     if (tr.thermal.present) {
       T0_ = tr.thermal.environment.at(0.0);
       net_ = ThermalNetwork(tr.thermal.nodes, tr.thermal.links, T0_);
@@ -93,6 +97,7 @@ class VirtualMachine : public gcode::MachineInterface {
     for (const auto& s : tr.thermal.sensors) inputs_ << "," << s.column;
     inputs_ << ",c_rpm,spindle_rpm,feed_mm_per_min,mwf_on,tool_changes\n";
     if (w_) stock_ = Stock(w_->stock_min_mm, w_->stock_max_mm);
+    if (tr.duty.tool_changes_per_hour > 0) next_duty_change_ = drawDutyGap();
     // At rest at the top of Z (the tool-change height region), X and Y at the C axis.
     pos_.xyz_mm = Vector3d(std::clamp(m_.c_axis_centre_mm.x(), m_.x.min_mm, m_.x.max_mm),
                            std::clamp(m_.c_axis_centre_mm.y(), m_.y.min_mm, m_.y.max_mm), m_.z.max_mm);
@@ -163,9 +168,21 @@ class VirtualMachine : public gcode::MachineInterface {
     const double extra_mm = pre_um * 1e-3 + F / 60.0 * tr_.probe.trigger_delay_s;
     const double s_trig = s_contact >= 0 ? s_contact + extra_mm / len : 2.0;
     if (s_contact < 0 || s_trig > 1.0) return noTrigger(to, len, F);
+    // The clock runs while the tip approaches (~1 s): the tip meets the artifact where the
+    // errors of the contact time put it, which matters for fast effects (a settling
+    // transient of 10 min moves 0.15 % in that second). Move to the contact found with the
+    // errors at the start, then find it again with the errors now: a nanometre correction,
+    // forward or back along the line.
+    const double approach_mm = s_contact * len;
+    move(approach_mm / F * 60.0, F);
+    pos_.xyz_mm = g0 + approach_mm * dir;
+    const Artifact now = artifact();
+    const double s_now = sphereEntryOnLine(tipActual(pos_.xyz_mm), tipActual(g1), now).value_or(0.0);
+    const double travel_mm = s_now * (len - approach_mm) + extra_mm;
+    if (approach_mm + travel_mm > len) return noTrigger(to, len - approach_mm, F);
     ProbeEvent ev = newEvent(dir, pre_um);
-    fillTruth(ev, art);
-    return latchTrigger(ev, dir, s_trig * len, F);
+    fillTruth(ev, now);
+    return latchTrigger(ev, dir, travel_mm, F);
   }
 
   // No trigger within the move: G38.2/G38.3 and G31 all end at the target.
@@ -187,7 +204,7 @@ class VirtualMachine : public gcode::MachineInterface {
   // The controller latches the trigger: repeatability noise along the approach, the axes'
   // resolution, the clock at the trigger, the event for the truth and the next log line.
   gcode::ProbeOutcome latchTrigger(ProbeEvent ev, const Vector3d& dir, double travel_mm, double F) {
-    ev.noise_um = tr_.probe.noise_um > 0 ? tr_.probe.noise_um * normal_(noise_rng_) : 0.0;
+    ev.noise_um = tr_.probe.noise_um > 0 ? tr_.probe.noise_um * noise_normal_(noise_rng_) : 0.0;
     Vector3d latched = pos_.xyz_mm + travel_mm * dir + ev.noise_um * 1e-3 * dir;
     if (tr_.probe.quantise) {
       const double q[3] = {m_.x.resolution_mm, m_.y.resolution_mm, m_.z.resolution_mm};
@@ -223,12 +240,12 @@ class VirtualMachine : public gcode::MachineInterface {
     if (spindle_rpm_ != 0) throw SafetyError("tool change with the spindle turning (M5 first)");
     const double t0 = t_;
     advance(m_.tool_change.time_s);
-    ++tool_changes_;
     tool_ = tool;
     traceRow("tool_change", pos_, 0, t0);
     atc_um_.setZero();
     if (probe && tr_.atc_repeatability_um > 0)
-      for (int k = 0; k < 3; ++k) atc_um_(k) = tr_.atc_repeatability_um * normal_(atc_rng_);
+      for (int k = 0; k < 3; ++k) atc_um_(k) = tr_.atc_repeatability_um * atc_normal_(atc_rng_);
+    recordToolChange("program");
   }
 
   double toolLength(int tool) const override {
@@ -275,7 +292,10 @@ class VirtualMachine : public gcode::MachineInterface {
   nlohmann::ordered_json cuts_ = nlohmann::ordered_json::array();
   const MachineTruth& tr_;
   std::mt19937_64 noise_rng_, atc_rng_, sensor_rng_, duty_rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
+  // One normal distribution per stream: std::normal_distribution keeps the second value of
+  // each pair it draws, so a shared one would hand one stream's draw to another.
+  std::normal_distribution<double> noise_normal_{0.0, 1.0}, atc_normal_{0.0, 1.0}, sensor_normal_{0.0, 1.0},
+      duty_atc_normal_{0.0, 1.0};
   ThermalNetwork net_;
   double T0_ = 20;
   std::vector<double> sensor_offset_;
@@ -290,6 +310,11 @@ class VirtualMachine : public gcode::MachineInterface {
   bool coolant_ = false, dwelling_ = false;
   int tool_changes_ = 0;
   std::vector<double> duty_levels_;  // random C levels per hold period, drawn as needed
+  std::mt19937_64 duty_tc_rng_, duty_atc_rng_;  // duty tool changes: times, probe re-seating
+  double dwell_clock_ = 0;                      // time spent dwelling so far
+  double next_duty_change_ = -1;                // dwell-clock time of the next one (-1 = none)
+  double settling_ = 0;                         // sum of the decaying unit jumps of the changes
+  nlohmann::ordered_json tool_change_log_ = nlohmann::ordered_json::array();
   std::ostringstream log_, inputs_;
   long log_lines_ = 0, pending_ = -1;
   std::string log_name_;
@@ -377,11 +402,45 @@ class VirtualMachine : public gcode::MachineInterface {
       const double next_sample = static_cast<double>(sample_index_) * rate;
       double h = std::min(dt, tr_.thermal.max_step_s);
       if (next_sample > t_ + 1e-9) h = std::min(h, next_sample - t_);
+      // A duty tool change ends the step, so it happens at its own time.
+      const bool duty_change_due = dwelling_ && next_duty_change_ >= 0;
+      if (duty_change_due) h = std::min(h, std::max(0.0, next_duty_change_ - dwell_clock_));
       if (tr_.thermal.present) net_.advance(h, tr_.thermal.environment.at(t_ + h / 2), heat(t_ + h / 2));
+      if (tr_.settling_tau_s > 0) settling_ = model::decayStep(settling_, h, tr_.settling_tau_s);
       t_ += h;
       dt -= h;
+      if (dwelling_) dwell_clock_ += h;
+      while (duty_change_due && dwell_clock_ >= next_duty_change_ - 1e-9) dutyToolChange();
       if (std::fabs(t_ - next_sample) <= 1e-9 || t_ > next_sample) sample();
     }
+  }
+
+  // Tool changes as a Poisson process on the dwell clock: exponential gaps (mean 1/rate).
+  double drawDutyGap() {
+    std::exponential_distribution<double> gap(tr_.duty.tool_changes_per_hour / 3600.0);
+    return dwell_clock_ + gap(duty_tc_rng_);
+  }
+
+  // Production work while the program waits: the probe goes to the magazine, another tool
+  // cuts, and the probe is seated again. One change is counted (the probe's return, the one
+  // that moves its tip): a new ATC step and a new settling jump. Instantaneous on the
+  // program's clock (the dwell's length is the program's).
+  void dutyToolChange() {
+    next_duty_change_ = drawDutyGap();
+    if (tool_ == m_.probe.tool && tr_.atc_repeatability_um > 0)
+      for (int k = 0; k < 3; ++k) atc_um_(k) = tr_.atc_repeatability_um * duty_atc_normal_(duty_atc_rng_);
+    recordToolChange("duty");
+  }
+
+  // Counted in the inputs CSV's next row; a holder seated in the warm spindle starts a unit
+  // settling jump. The jumps add: the spindle nose's heat deficit obeys a linear heat
+  // equation, so the responses to successive cold holders superpose (model/effects.hpp
+  // `transient`, the same primitive). The empty spindle seats no holder.
+  void recordToolChange(const char* source) {
+    ++tool_changes_;
+    const bool holder = tool_ != m_.tool_change.empty_tool;
+    if (holder && tr_.settling_tau_s > 0) settling_ += 1.0;
+    tool_change_log_.push_back({{"time_s", t_}, {"tool", tool_}, {"source", source}});
   }
 
   void sample() {
@@ -389,7 +448,7 @@ class VirtualMachine : public gcode::MachineInterface {
     for (std::size_t i = 0; i < tr_.thermal.sensors.size(); ++i) {
       const auto& s = tr_.thermal.sensors[i];
       const double T = s.node < 0 ? tr_.thermal.environment.at(t_) : net_.temperatures_C()(s.node);
-      const double noisy = T + sensor_offset_[i] + (s.noise_K > 0 ? s.noise_K * normal_(sensor_rng_) : 0.0);
+      const double noisy = T + sensor_offset_[i] + (s.noise_K > 0 ? s.noise_K * sensor_normal_(sensor_rng_) : 0.0);
       inputs_ << "," << formatNumber(noisy, 3);
     }
     inputs_ << "," << formatNumber(cRpm(t_), 3) << "," << formatNumber(spindle_rpm_, 3) << ","
@@ -399,6 +458,8 @@ class VirtualMachine : public gcode::MachineInterface {
     last_sample_t_ = t_;
     ++sample_index_;
   }
+
+  double settlingUm() const { return tr_.settling_tool_Z_um * settling_; }
 
   double nodeRise(int node) const {
     return node < 0 || !tr_.thermal.present ? 0.0 : net_.temperatures_C()(node) - T0_;
@@ -410,6 +471,7 @@ class VirtualMachine : public gcode::MachineInterface {
     if (tr_.thermal.present)
       for (int i = 0; i < net_.size(); ++i)
         for (int k = 0; k < 3; ++k) d(k) += tr_.thermal.per_node_K[i].tool_um[k] * nodeRise(i);
+    d.z() += settlingUm();
     return d + atc_um_;
   }
 
@@ -492,6 +554,17 @@ class VirtualMachine : public gcode::MachineInterface {
     if (disc < 0 || A == 0) return -1.0;
     const double s = (-B - std::sqrt(disc)) / A;
     return s >= 0 && s <= 1 ? s : -1.0;
+  }
+
+  // Where the tip sphere enters the artifact sphere on the whole line through a and b
+  // (parameter s, negative = behind a); none if the line misses it.
+  std::optional<double> sphereEntryOnLine(const Vector3d& a, const Vector3d& b, const Artifact& art) const {
+    const double Rt = art.radius + tipRadius();
+    const Vector3d d = b - a, w = a - art.centre;
+    const double A = d.squaredNorm(), B = d.dot(w), C = w.squaredNorm() - Rt * Rt;
+    const double disc = B * B - A * C;
+    if (disc < 0 || A == 0) return std::nullopt;
+    return (-B - std::sqrt(disc)) / A;
   }
 
   void checkStemAndTable(const Vector3d& a, const Vector3d& b, const Artifact& art, const std::string& what) const {
@@ -726,6 +799,7 @@ class VirtualMachine : public gcode::MachineInterface {
     ev.location = locationErrors();
     ev.tool_um = toolDriftUm();
     ev.atc_um = atc_um_;
+    ev.settling_um = settlingUm();
     ev.artifact_dT_K = nodeRise(tr_.artifact.node);
     ev.apparent = ev.location;
     return latchTrigger(ev, dir, s_trig, F);
@@ -739,24 +813,27 @@ class VirtualMachine : public gcode::MachineInterface {
   }
   std::string traceText() const { return trace_.str(); }
   std::string cutsJson() const { return cuts_.dump(1) + "\n"; }
+  const nlohmann::ordered_json& toolChangeLog() const { return tool_change_log_; }
 
  private:
   void fillTruth(ProbeEvent& ev, const Artifact& art) const {
     ev.location = art.location;
     ev.tool_um = toolDriftUm();
     ev.atc_um = atc_um_;
+    ev.settling_um = settlingUm();
     ev.artifact_dT_K = art.dT;
     // What a sphere campaign evaluation sees: table errors minus the tool's translation,
     // plus the artifact's own growth (radius from the axis and height).
     ev.apparent = art.location;
-    const double a = partAlpha() * art.dT;
+    const double alpha_um_per_m_K = partAlpha() * 1e6;
     ev.apparent[0] -= ev.tool_um.x();
     ev.apparent[1] -= ev.tool_um.y();
     ev.apparent[2] -= ev.tool_um.z();
     // The ball grows too; the known-radius fit reads that as a lift of the centre by the
-    // radius change, because only the top point sees Z (docs/simulator.md).
-    ev.apparent[2] += a * (a_->centreHeightAboveTable() + a_->sphereRadius()) * 1e3;
-    ev.apparent[3] += a * a_->radius_from_axis_mm * 1e3;
+    // radius change, because only the top point sees Z (docs/simulator.md). The same
+    // alpha L dT as the model's `expansion` effect.
+    ev.apparent[2] += model::expansion_um(alpha_um_per_m_K, a_->centreHeightAboveTable() + a_->sphereRadius(), art.dT);
+    ev.apparent[3] += model::expansion_um(alpha_um_per_m_K, a_->radius_from_axis_mm, art.dT);
   }
 };
 
@@ -845,6 +922,7 @@ SimulationOutputs simulateProgram(const std::string& program_file, const std::st
     for (int j = 0; j < 7; ++j) je[names[j]] = e.location[j];
     je["tool_um"] = {e.tool_um.x(), e.tool_um.y(), e.tool_um.z()};
     je["atc_um"] = {e.atc_um.x(), e.atc_um.y(), e.atc_um.z()};
+    je["settling_um"] = e.settling_um;
     je["artifact_dT_K"] = e.artifact_dT_K;
     je["pretravel_um"] = e.pretravel_um;
     je["noise_um"] = e.noise_um;
@@ -863,6 +941,7 @@ SimulationOutputs simulateProgram(const std::string& program_file, const std::st
       jt["cycles"].push_back(jc);
     }
   }
+  jt["tool_changes"] = vm.toolChangeLog();
   out.points_csv = csv.str();
   out.truth_json = jt.dump(1) + "\n";
   return out;

@@ -1,0 +1,242 @@
+#include "cli/model_commands.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <sstream>
+
+#include "core/atomic_file.hpp"
+#include "core/csv.hpp"
+#include "core/error.hpp"
+#include "model/diagnose.hpp"
+#include "model/outputs.hpp"
+#include "model/talc.hpp"
+#include "parts/error_model_file.hpp"
+#include "parts/sphere_artifact.hpp"
+#include "report/model_report.hpp"
+
+namespace probeloop::cli {
+namespace fs = std::filesystem;
+
+namespace {
+
+struct ModelArgs {
+  std::vector<std::string> models;
+  std::string inputs, errors, json, report, part;
+  // add
+  std::string kind, model, channels, input;
+  std::optional<double> tau_s, alpha, length_mm;
+  bool tau_fixed = false;
+  // talc
+  model::TalcOptions talc;
+  std::string talc_inputs;
+};
+
+std::string resolve(const std::string& model_file, const std::string& p) {
+  if (p.empty() || fs::path(p).is_absolute()) return p;
+  return (fs::path(model_file).parent_path() / p).lexically_normal().string();
+}
+
+model::Campaign campaignFor(const model::ErrorModel& m, const ModelArgs& a) {
+  const std::string in = a.inputs.empty() ? resolve(m.file, m.inputs_path) : a.inputs;
+  const std::string er = a.errors.empty() ? resolve(m.file, m.errors_path) : a.errors;
+  if (in.empty() || er.empty())
+    throw InputError(m.file, 0, "no data: give --inputs and --errors, or data: {inputs: ..., errors: ...} in the model file");
+  return model::loadCampaign(in, er);
+}
+
+std::optional<model::ArtifactLengths> artifactLengths(const std::string& part) {
+  if (part.empty()) return std::nullopt;
+  const auto art = parts::loadSphereArtifact(part);
+  if (!(art.alpha_um_per_m_K > 0))
+    throw InputError(part, 0, "uncertainty.alpha_um_per_m_K: the expansion candidates need the artifact's expansion coefficient");
+  return model::ArtifactLengths{art.alpha_um_per_m_K, art.centreHeightAboveTable() + art.sphereRadius(),
+                                art.radius_from_axis_mm};
+}
+
+void writeReport(const std::string& path, const nlohmann::json& fit, const nlohmann::json* diag) {
+  if (path.empty()) return;
+  writeFileAtomic(path, report::modelReportHtml(fit, diag));
+  std::printf("\nWrote %s\n", path.c_str());
+}
+
+int runFit(const ModelArgs& a) {
+  const auto m = parts::loadErrorModel(a.models.front());
+  const auto c = campaignFor(m, a);
+  const auto f = model::fitModel(c, m);
+  const auto j = model::fitJson(c, m, f);
+  if (!a.json.empty()) writeFileAtomic(a.json, j.dump(1) + "\n");
+  std::fputs(model::fitText(c, m, f).c_str(), stdout);
+  writeReport(a.report, j, nullptr);
+  return 0;
+}
+
+int runCompare(const ModelArgs& a) {
+  std::vector<model::ErrorModel> ms;
+  for (const auto& p : a.models) ms.push_back(parts::loadErrorModel(p));
+  const auto c = campaignFor(ms.front(), a);
+  std::vector<model::ModelFit> fits;
+  for (const auto& m : ms) fits.push_back(model::fitModel(c, m, ms.front().training_fraction));
+  if (!a.json.empty()) writeFileAtomic(a.json, model::compareJson(c, ms, fits).dump(1) + "\n");
+  std::fputs(model::compareText(c, ms, fits).c_str(), stdout);
+  return 0;
+}
+
+int runDiagnose(const ModelArgs& a) {
+  const auto m = parts::loadErrorModel(a.models.front());
+  const auto c = campaignFor(m, a);
+  model::DiagnoseOptions opt;
+  opt.artifact = artifactLengths(a.part);
+  opt.artifact_path = a.part;
+  opt.model_path = a.models.front();
+  const auto d = model::diagnose(c, m, opt);
+  const auto dj = model::diagnosisJson(c, m, d);
+  if (!a.json.empty()) writeFileAtomic(a.json, dj.dump(1) + "\n");
+  std::fputs(model::diagnosisText(c, m, d).c_str(), stdout);
+  if (!a.report.empty()) {
+    model::ModelFit f;
+    f.after = d.fits;
+    f.train_end = model::trainingEnd(c.errors.size(), m.training_fraction);
+    writeReport(a.report, model::fitJson(c, m, f), &dj);
+  }
+  return 0;
+}
+
+int runAdd(const ModelArgs& a) {
+  auto m = parts::loadErrorModel(a.model);
+  const auto kind = model::kindFromName(a.kind);
+  if (!kind || *kind == model::EffectKind::Offset)
+    throw InputError("", 0, "model add: unknown effect '" + a.kind + "'; the effects are drift, static, lag, transient, expansion");
+  std::vector<std::string> chans;
+  std::stringstream ss(a.channels);
+  for (std::string s; std::getline(ss, s, ',');) {
+    const auto b = s.find_first_not_of(" \t"), e = s.find_last_not_of(" \t");
+    if (b == std::string::npos) continue;
+    s = s.substr(b, e - b + 1);
+    if (s.find_first_of(" \t:#{}[],'\"") != std::string::npos)
+      throw InputError("", 0, "model add: '" + s + "' is not a channel name (as in errors.csv, e.g. EY0C_um)");
+    chans.push_back(s);
+  }
+  if (chans.empty()) throw InputError("", 0, "model add: --channels lists no channel");
+  model::Effect e = model::makeEffect(*kind, a.input);
+  if (*kind == model::EffectKind::Drift && !a.input.empty())
+    throw InputError("", 0, "model add drift: a drift reads no input; leave out --input");
+  if (*kind != model::EffectKind::Drift && a.input.empty())
+    throw InputError("", 0, "model add " + a.kind + ": needs --input (an inputs.csv column)");
+  if (e.hasTimeConstant()) {
+    e.tau_s = a.tau_s;
+    e.tau_fixed = a.tau_fixed;
+    if (e.tau_fixed && !e.tau_s) throw InputError("", 0, "model add: --tau-fixed needs --tau-s");
+  }
+  const auto lengths = artifactLengths(a.part);
+  for (auto& c : m.channels)
+    for (auto& x : c.effects) x.just_added = false;
+  std::vector<std::string> created;
+  for (const auto& name : chans) {
+    model::Effect ce = e;
+    ce.just_added = true;
+    if (*kind == model::EffectKind::Expansion) {
+      ce.alpha_um_per_m_K = a.alpha ? *a.alpha : lengths ? lengths->alpha_um_per_m_K : 0;
+      ce.length_mm = a.length_mm ? *a.length_mm
+                     : !lengths ? 0
+                     : name.rfind("EZ0T", 0) == 0 ? lengths->height_mm
+                     : name.rfind("ER0T", 0) == 0 ? lengths->radius_mm
+                                                  : 0;
+      if (!(ce.alpha_um_per_m_K > 0 && ce.length_mm > 0))
+        throw InputError("", 0, "model add expansion on " + name +
+                                    ": needs --part (a sphere artifact: EZ0T uses its height, ER0T its radius from the C axis) "
+                                    "or --alpha-um-per-m-K and --length-mm");
+    }
+    auto it = std::find_if(m.channels.begin(), m.channels.end(), [&](const model::ChannelModel& c) { return c.channel == name; });
+    if (it == m.channels.end()) {
+      m.channels.push_back({name, {}});
+      it = std::prev(m.channels.end());
+      created.push_back(name);
+    }
+    for (const auto& have : it->effects)
+      if (have.id() == ce.id()) throw InputError(a.model, 0, "channels." + name + ": already has " + ce.id());
+    it->effects.push_back(ce);
+  }
+  parts::saveErrorModel(m, a.model);
+  std::printf("Added %s to %s in %s", e.id().c_str(), a.channels.c_str(), a.model.c_str());
+  if (!created.empty()) std::printf(" (new channels: %zu)", created.size());
+  std::printf(".\nThe file was rewritten in canonical form (comments are not kept). Next, to see before and after:\n"
+              "  probeloop model fit %s\n", a.model.c_str());
+  return 0;
+}
+
+int runTalc(const ModelArgs& a) {
+  if (a.inputs.empty() || a.errors.empty()) throw InputError("", 0, "model talc: give --inputs and --errors");
+  const auto c = model::loadCampaign(a.inputs, a.errors);
+  model::TalcOptions o = a.talc;
+  std::stringstream ss(a.talc_inputs);
+  for (std::string s; std::getline(ss, s, ',');)
+    if (!s.empty()) o.inputs.push_back(s);
+  const auto r = model::replayTalc(c, o);
+  std::fputs(model::talcText(r).c_str(), stdout);
+  return 0;
+}
+
+}  // namespace
+
+std::function<int()> addModelCommands(CLI::App& app, CLI::App*& group) {
+  auto a = std::make_shared<ModelArgs>();
+  group = app.add_subcommand("model", "Error models against measurements: fit, compare, diagnose, add an effect");
+  group->require_subcommand(1);
+  auto data = [a](CLI::App* s) {
+    s->add_option("--inputs", a->inputs, "inputs.csv of the campaign (default: data.inputs of the model file)")->check(CLI::ExistingFile);
+    s->add_option("--errors", a->errors, "errors.csv of the campaign (default: data.errors of the model file)")->check(CLI::ExistingFile);
+    s->add_option("--json", a->json, "also write the results as JSON to this file");
+  };
+  auto* fit = group->add_subcommand("fit", "Fit the model on the training span, predict the validation span, report the indicators");
+  fit->add_option("model", a->models, "error model (YAML, kind: error_model)")->required()->expected(1)->check(CLI::ExistingFile);
+  data(fit);
+  fit->add_option("--report", a->report, "also write the HTML report to this file");
+  auto* cmp = group->add_subcommand("compare", "Several models on the same campaign, side by side");
+  cmp->add_option("models", a->models, "error models (YAML)")->required()->expected(1, 20)->check(CLI::ExistingFile);
+  data(cmp);
+  auto* dia = group->add_subcommand("diagnose", "Where the model fails and which effect is missing, ranked, with the command that adds it");
+  dia->add_option("model", a->models, "error model (YAML)")->required()->expected(1)->check(CLI::ExistingFile);
+  data(dia);
+  dia->add_option("--part", a->part, "sphere artifact (YAML): enables the artifact-expansion candidates")->check(CLI::ExistingFile);
+  dia->add_option("--report", a->report, "also write the HTML report to this file");
+  auto* add = group->add_subcommand("add", "Add an effect to channels of a model file (marked just_added: the next fit shows before and after)");
+  add->add_option("effect", a->kind, "drift, static, lag, transient or expansion")
+      ->required()->check(CLI::IsMember({"drift", "static", "lag", "transient", "expansion"}));
+  add->add_option("--model", a->model, "error model file to edit")->required()->check(CLI::ExistingFile);
+  add->add_option("--channels", a->channels, "comma-separated channels, e.g. EY0C_um,EZ0T_um")->required();
+  add->add_option("--input", a->input, "inputs.csv column the effect reads");
+  add->add_option("--tau-s", a->tau_s, "lag/transient: time constant to start from, s")->check(CLI::PositiveNumber);
+  add->add_flag("--tau-fixed", a->tau_fixed, "keep the time constant fixed");
+  add->add_option("--part", a->part, "expansion: the sphere artifact (YAML) giving alpha and the lengths")->check(CLI::ExistingFile);
+  add->add_option("--alpha-um-per-m-K", a->alpha, "expansion: coefficient")->check(CLI::PositiveNumber);
+  add->add_option("--length-mm", a->length_mm, "expansion: length")->check(CLI::PositiveNumber);
+  auto* talc = group->add_subcommand("talc", "Adaptive replay of seed 004 Ch. 6 (TALC) over a densely measured campaign: P99 reduction as Tables 6.5/6.7");
+  talc->add_option("--inputs", a->inputs, "inputs.csv of the campaign")->required()->check(CLI::ExistingFile);
+  talc->add_option("--errors", a->errors, "errors.csv of the campaign (measured densely)")->required()->check(CLI::ExistingFile);
+  talc->add_option("--cp-h", a->talc.cp_h, "calibration phase, h (0: as short as possible)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  talc->add_option("--post-interval-h", a->talc.post_interval_h, "measurement interval after the CP, h")->capture_default_str()->check(CLI::PositiveNumber);
+  talc->add_option("--ng-interval-min", a->talc.ng_interval_min, "No-Good phase measurement interval, min")->capture_default_str()->check(CLI::PositiveNumber);
+  talc->add_option("--ng-measurements", a->talc.ng_measurements, "measurements per No-Good phase")->capture_default_str()->check(CLI::PositiveNumber);
+  talc->add_option("--update-interval-h", a->talc.update_interval_h, "periodic parameter update, h (0: none)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  talc->add_option("--limit-linear-um", a->talc.limit_linear_um, "action limit of the linear errors, um")->capture_default_str()->check(CLI::PositiveNumber);
+  talc->add_option("--limit-angular-urad", a->talc.limit_angular_urad, "action limit of the angular errors, urad (= um/m)")->capture_default_str()->check(CLI::PositiveNumber);
+  talc->add_option("--na", a->talc.na, "ARX output order")->capture_default_str()->check(CLI::NonNegativeNumber);
+  talc->add_option("--nb", a->talc.nb, "ARX input order (coefficients per input)")->capture_default_str()->check(CLI::PositiveNumber);
+  talc->add_option("--model-inputs", a->talc_inputs, "comma-separated input columns ('|c_rpm|' for a magnitude); default: the temperatures");
+  talc->add_option("--predicted-weight", a->talc.predicted_weight, "WLS weight of rows whose target is a prediction (Eq. 4.20)")->capture_default_str();
+  talc->add_option("--cycle-duration-s", a->talc.cycle_duration_s, "duration of one measurement cycle, s (Q_Prod, Eq. 6.1)")->capture_default_str()->check(CLI::PositiveNumber);
+  talc->add_flag("--include-cp", a->talc.include_cp, "P99 over the whole campaign, not only after the CP");
+  return [a, fit, cmp, dia, add, talc]() -> int {
+    if (*talc) return runTalc(*a);
+    if (*fit) return runFit(*a);
+    if (*cmp) return runCompare(*a);
+    if (*dia) return runDiagnose(*a);
+    if (*add) return runAdd(*a);
+    return 2;
+  };
+}
+
+}  // namespace probeloop::cli

@@ -1,0 +1,80 @@
+// The error-model file: what `probeloop model add` writes loads back as the same model, with
+// any path or name; bad files are refused with their line.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "core/error.hpp"
+#include "parts/error_model_file.hpp"
+
+using namespace probeloop;
+
+namespace {
+std::string tempFile(const std::string& name, const std::string& text) {
+  const auto p = (std::filesystem::temp_directory_path() / ("probeloop_em_" + name)).string();
+  std::ofstream(p) << text;
+  return p;
+}
+}  // namespace
+
+TEST(ErrorModelFile, WhatIsWrittenLoadsBackTheSame) {
+  model::ErrorModel m;
+  m.inputs_path = "run #1/in: \"quoted\" \\ inputs.csv";
+  m.errors_path = "*eval/errors.csv";
+  m.training_fraction = 0.55;
+  model::Effect lag = model::makeEffect(model::EffectKind::Lag, "c_rpm");
+  lag.tau_s = 7529.172352784451;
+  lag.just_added = true;
+  model::Effect fixed = model::makeEffect(model::EffectKind::Transient, "tool_changes");
+  fixed.tau_s = 0.4;
+  fixed.tau_fixed = true;
+  model::Effect exp = model::makeEffect(model::EffectKind::Expansion, "T_table_C");
+  exp.alpha_um_per_m_K = 11.5;
+  exp.length_mm = 90;
+  m.channels = {{"EY0C_um", {lag, model::makeEffect(model::EffectKind::Drift)}}, {"EZ0T_um", {fixed, exp}}, {"EX0C_um", {}}};
+  const auto path = tempFile("roundtrip.yaml", "");
+  parts::saveErrorModel(m, path);
+  const auto back = parts::loadErrorModel(path);
+  EXPECT_EQ(back.inputs_path, m.inputs_path);
+  EXPECT_EQ(back.errors_path, m.errors_path);
+  EXPECT_EQ(back.training_fraction, 0.55);
+  ASSERT_EQ(back.channels.size(), 3u);
+  for (std::size_t c = 0; c < 3; ++c) {
+    EXPECT_EQ(back.channels[c].channel, m.channels[c].channel);
+    ASSERT_EQ(back.channels[c].effects.size(), m.channels[c].effects.size());
+    for (std::size_t k = 0; k < m.channels[c].effects.size(); ++k) {
+      const auto &a = m.channels[c].effects[k], &b = back.channels[c].effects[k];
+      EXPECT_EQ(b.id(), a.id());
+      EXPECT_EQ(b.tau_s.has_value(), a.tau_s.has_value());
+      if (a.tau_s) EXPECT_EQ(*b.tau_s, *a.tau_s);  // shortest round-trip decimal: exact
+      EXPECT_EQ(b.tau_fixed, a.tau_fixed);
+      EXPECT_EQ(b.just_added, a.just_added);
+      EXPECT_EQ(b.alpha_um_per_m_K, a.alpha_um_per_m_K);
+      EXPECT_EQ(b.length_mm, a.length_mm);
+    }
+  }
+  EXPECT_EQ(parts::errorModelYaml(back), parts::errorModelYaml(m));
+}
+
+TEST(ErrorModelFile, RefusesBadFilesWithTheirLine) {
+  auto msg = [](const std::string& name, const std::string& text) {
+    try {
+      parts::loadErrorModel(tempFile(name, text));
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(msg("k.yaml", "kind: gum_model\nchannels: {E: []}\n").find("expected 'error_model'"), std::string::npos);
+  EXPECT_NE(msg("e.yaml", "kind: error_model\nchannels:\n  E:\n    - {effect: lag, input: T, tau: -1 s}\n").find(":4:"),
+            std::string::npos);
+  EXPECT_NE(msg("f.yaml", "kind: error_model\nchannels:\n  E: [{effect: lag, input: T, tau_fixed: true}]\n")
+                .find("a fixed time constant needs tau"),
+            std::string::npos);
+  EXPECT_NE(msg("x.yaml", "kind: error_model\nchannels:\n  E: [{effect: expansion, input: T, alpha_um_per_m_K: 0, length: 9 mm}]\n")
+                .find("must be > 0"),
+            std::string::npos);
+  EXPECT_NE(msg("t.yaml", "kind: error_model\ntraining_fraction: 1.5\nchannels: {E: []}\n").find("(0, 1]"), std::string::npos);
+  EXPECT_NE(msg("u.yaml", "kind: error_model\nchannels: {E: []}\nextra: 1\n").find("extra"), std::string::npos);
+}

@@ -1,0 +1,994 @@
+#include "report/model_report.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
+#include <string_view>
+#include <vector>
+
+#include "core/error.hpp"
+
+namespace probeloop::report {
+namespace {
+
+using nlohmann::json;
+
+constexpr const char* kVegaInstallHint =
+    "Vega 5 comes with the Debian package libjs-vega (apt-get install libjs-vega; scripts/setup.sh installs it)";
+
+// ---------------------------------------------------------------------------------------
+// Reading optional fields: null and missing are the same, a wrong type counts as missing.
+
+const json* field(const json& o, const char* key) {
+  if (!o.is_object()) return nullptr;
+  const auto it = o.find(key);
+  if (it == o.end() || it->is_null()) return nullptr;
+  return &*it;
+}
+
+std::optional<double> number(const json* v) {
+  if (v == nullptr || !v->is_number()) return std::nullopt;
+  const double d = v->get<double>();
+  if (!std::isfinite(d)) return std::nullopt;
+  return d;
+}
+std::optional<double> number(const json& o, const char* key) { return number(field(o, key)); }
+
+std::string text(const json& o, const char* key) {
+  const json* v = field(o, key);
+  if (v == nullptr) return "";
+  if (v->is_string()) return v->get<std::string>();
+  return v->dump(-1, ' ', false, json::error_handler_t::replace);
+}
+
+const json& array(const json& o, const char* key) {
+  static const json empty = json::array();
+  const json* v = field(o, key);
+  return v != nullptr && v->is_array() ? *v : empty;
+}
+
+const json& object(const json& o, const char* key) {
+  static const json empty = json::object();
+  const json* v = field(o, key);
+  return v != nullptr && v->is_object() ? *v : empty;
+}
+
+std::optional<bool> boolean(const json& o, const char* key) {
+  const json* v = field(o, key);
+  if (v == nullptr || !v->is_boolean()) return std::nullopt;
+  return v->get<bool>();
+}
+
+// ---------------------------------------------------------------------------------------
+// Text: HTML escaping, units, numbers (C locale, "—" for anything not a finite number).
+
+const std::string kDash = "\u2014";
+
+std::string esc(std::string_view s) {
+  std::string out;
+  out.reserve(s.size());
+  for (const char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&#39;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+// JSON for a <script> element: the only characters that could end the element or open a
+// comment are <, > and &, which JSON allows only inside strings, where \uXXXX means the same.
+std::string scriptJson(const json& j) {
+  const std::string s = j.dump(-1, ' ', false, json::error_handler_t::replace);
+  std::string out;
+  out.reserve(s.size());
+  for (const char c : s) {
+    if (c == '<') out += "\\u003c";
+    else if (c == '>') out += "\\u003e";
+    else if (c == '&') out += "\\u0026";
+    else out += c;
+  }
+  return out;
+}
+
+// "um" -> "µm", "urad" -> "µrad" wherever they stand as a word ("um/rpm" -> "µm/rpm").
+std::string displayUnit(const std::string& u) {
+  std::string out;
+  std::size_t i = 0;
+  while (i < u.size()) {
+    if (std::isalpha(static_cast<unsigned char>(u[i]))) {
+      std::size_t j = i;
+      while (j < u.size() && std::isalnum(static_cast<unsigned char>(u[j]))) ++j;
+      const std::string word = u.substr(i, j - i);
+      out += word == "um" ? "\u00b5m" : word == "urad" ? "\u00b5rad" : word;
+      i = j;
+    } else {
+      out += u[i++];
+    }
+  }
+  return out;
+}
+
+// "-0.00" -> "0.00".
+std::string dropNegativeZero(std::string s) {
+  if (!s.empty() && s[0] == '-' && s.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);
+  return s;
+}
+
+std::string fixed(double x, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, x);
+  return dropNegativeZero(buf);
+}
+
+// `digits` significant digits, plain notation between 1e-4 and 1e7.
+std::string sig(double x, int digits) {
+  if (!std::isfinite(x)) return kDash;
+  if (x == 0.0) return "0";
+  const int e = static_cast<int>(std::floor(std::log10(std::abs(x))));
+  if (e < -4 || e >= 7) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.*e", digits - 1, x);
+    return buf;
+  }
+  return fixed(x, std::max(0, digits - 1 - e));
+}
+std::string sig(const std::optional<double>& x, int digits) { return x ? sig(*x, digits) : kDash; }
+
+// GUM style: u with two significant digits, the value to the same decimal place.
+std::string valueU(const std::optional<double>& v, const std::optional<double>& u) {
+  if (!v) return kDash;
+  if (!u || *u <= 0.0) return sig(*v, 4);
+  const int eu = static_cast<int>(std::floor(std::log10(*u)));
+  if (eu < -9 || eu > 9 || std::abs(*v) >= 1e9) return sig(*v, 4) + " \u00b1 " + sig(*u, 2);
+  const int decimals = std::max(0, 1 - eu);
+  return fixed(*v, decimals) + " \u00b1 " + fixed(*u, decimals);
+}
+
+// Counts (samples, lags, ranks): integers as integers.
+std::string whole(const std::optional<double>& x) {
+  if (!x) return kDash;
+  if (std::abs(*x) < 1e15 && *x == std::round(*x)) return fixed(*x, 0);
+  return sig(*x, 6);
+}
+
+std::string hours(const std::optional<double>& s) { return s ? fixed(*s / 3600.0, 2) : kDash; }
+
+std::string withUnit(const std::string& value, const std::string& unit) {
+  return unit.empty() || value == kDash ? value : value + " " + unit;
+}
+
+std::string beforeAfter(const std::string& before, const std::string& after) {
+  return "<span class=\"before\">" + esc(before) + "</span> \u2192 " + esc(after);
+}
+
+// ---------------------------------------------------------------------------------------
+// Channels.
+
+struct ChannelName {
+  std::string id;      // as in the input, "EY0C_um"
+  std::string unit;    // display unit, "µm" (empty when unknown)
+  std::string label;   // "EY0C"
+};
+
+ChannelName channelName(const json& c) {
+  ChannelName n;
+  n.id = text(c, "channel");
+  const std::string raw_unit = text(c, "unit");
+  n.unit = displayUnit(raw_unit);
+  n.label = n.id;
+  const std::string suffix = "_" + raw_unit;
+  if (!raw_unit.empty() && n.id.size() > suffix.size() &&
+      n.id.compare(n.id.size() - suffix.size(), suffix.size(), suffix) == 0)
+    n.label = n.id.substr(0, n.id.size() - suffix.size());
+  if (n.label.empty()) n.label = "(unnamed channel)";
+  return n;
+}
+
+std::string axisTitle(const ChannelName& n, const std::string& prefix) {
+  return prefix + n.label + (n.unit.empty() ? "" : " (" + n.unit + ")");
+}
+
+// ---------------------------------------------------------------------------------------
+// Vega specs (declarative JSON; Vega draws them). Data values are the input's numbers;
+// hours, residual and band limits are Vega formulas.
+
+const char* kMeasuredColour = "#222222";
+const char* kModelColour = "#1f5f9f";
+const char* kBandColour = "#cfe0f1";
+const char* kBeforeColour = "#8a8a8a";
+const char* kBeyondColour = "#c0392b";
+constexpr int kPlotWidth = 760;
+
+json filterTx(const std::string& expr) { return {{"type", "filter"}, {"expr", expr}}; }
+json formulaTx(const std::string& as, const std::string& expr) {
+  return {{"type", "formula"}, {"as", as}, {"expr", expr}};
+}
+
+struct SeriesData {
+  json rows = json::array();
+  bool has_measured = false, has_predicted = false, has_U = false, has_before = false;
+};
+
+json finiteOrNull(const json& a, std::size_t i) {
+  if (i < a.size() && number(&a[i])) return a[i];
+  return nullptr;
+}
+
+SeriesData seriesData(const json& series) {
+  SeriesData d;
+  const json& t = array(series, "time_s");
+  const json& m = array(series, "measured");
+  const json& p = array(series, "predicted");
+  const json& b = array(series, "predicted_before");
+  const json& U = array(series, "U");
+  const std::optional<double> U_scalar = number(series, "U");  // tolerated: one U for all rows
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (!number(&t[i])) continue;
+    json row = json::object();
+    row["time_s"] = t[i];
+    row["measured"] = finiteOrNull(m, i);
+    row["predicted"] = finiteOrNull(p, i);
+    row["U"] = U_scalar ? json(*U_scalar) : finiteOrNull(U, i);
+    d.has_measured |= !row["measured"].is_null();
+    d.has_predicted |= !row["predicted"].is_null();
+    d.has_U |= !row["U"].is_null();
+    if (!b.empty()) {
+      row["before"] = finiteOrNull(b, i);
+      d.has_before |= !row["before"].is_null();
+    }
+    d.rows.push_back(std::move(row));
+  }
+  return d;
+}
+
+struct Window {
+  double from_s = 0, to_s = 0;
+};
+
+std::optional<Window> span(const json& fit, const char* key) {
+  const json& s = object(fit, key);
+  const auto from = number(s, "from_s"), to = number(s, "to_s");
+  if (!from || !to || *to < *from) return std::nullopt;
+  return Window{*from, *to};
+}
+
+json baseSpec(const std::string& description, int height) {
+  json spec = json::object();
+  spec["$schema"] = "https://vega.github.io/schema/vega/v5.json";
+  spec["description"] = description;
+  spec["width"] = kPlotWidth;
+  spec["height"] = height;
+  spec["padding"] = 5;
+  spec["autosize"] = {{"type", "pad"}};
+  spec["config"] = {{"axis", {{"labelFont", "sans-serif"}, {"titleFont", "sans-serif"}, {"labelFontSize", 11},
+                              {"titleFontSize", 12}, {"titleFontWeight", "normal"}, {"gridColor", "#ececec"}}},
+                    {"legend", {{"labelFont", "sans-serif"}, {"labelFontSize", 11}}}};
+  return spec;
+}
+
+json seriesDataset(const SeriesData& d) {
+  return {{"name", "series"},
+          {"values", d.rows},
+          {"transform", json::array({filterTx("isValid(datum.time_s)"), formulaTx("t_h", "datum.time_s / 3600"),
+                                     {{"type", "collect"}, {"sort", {{"field", "time_s"}}}}})}};
+}
+
+void addValidationWindow(json& spec, const std::optional<Window>& validation) {
+  if (!validation) return;
+  spec["data"].push_back({{"name", "validation"},
+                          {"values", json::array({{{"from_s", validation->from_s}, {"to_s", validation->to_s}}})},
+                          {"transform", json::array({formulaTx("from_h", "datum.from_s / 3600"),
+                                                     formulaTx("to_h", "datum.to_s / 3600")})}});
+  spec["marks"].push_back({{"type", "rect"},
+                           {"name", "validation_window"},
+                           {"from", {{"data", "validation"}}},
+                           {"clip", true},
+                           {"encode", {{"enter", {{"x", {{"scale", "x"}, {"field", "from_h"}}},
+                                                  {"x2", {{"scale", "x"}, {"field", "to_h"}}},
+                                                  {"y", {{"value", 0}}},
+                                                  {"y2", {{"signal", "height"}}},
+                                                  {"fill", {{"value", "#000000"}}},
+                                                  {"fillOpacity", {{"value", 0.04}}}}}}}});
+  spec["marks"].push_back({{"type", "text"},
+                           {"from", {{"data", "validation"}}},
+                           {"clip", true},
+                           {"encode", {{"enter", {{"x", {{"scale", "x"}, {"field", "from_h"}, {"offset", 4}}},
+                                                  {"y", {{"value", 4}}},
+                                                  {"baseline", {{"value", "top"}}},
+                                                  {"text", {{"value", "validation"}}},
+                                                  {"fill", {{"value", "#777777"}}},
+                                                  {"font", {{"value", "sans-serif"}}},
+                                                  {"fontSize", {{"value", 10}}}}}}}});
+}
+
+// One legend for mixed marks: four ordinal scales over the same entry names.
+struct LegendEntry {
+  std::string name, shape, fill, stroke;
+  json dash;
+};
+
+void addLegend(json& spec, const std::vector<LegendEntry>& entries) {
+  json domain = json::array(), shape = json::array(), fill = json::array(), stroke = json::array(),
+       dash = json::array();
+  for (const auto& e : entries) {
+    domain.push_back(e.name);
+    shape.push_back(e.shape);
+    fill.push_back(e.fill);
+    stroke.push_back(e.stroke);
+    dash.push_back(e.dash);
+  }
+  const auto scale = [&](const char* name, const json& range) {
+    spec["scales"].push_back({{"name", name}, {"type", "ordinal"}, {"domain", domain}, {"range", range}});
+  };
+  scale("legend_shape", shape);
+  scale("legend_fill", fill);
+  scale("legend_stroke", stroke);
+  scale("legend_dash", dash);
+  spec["legends"] = json::array({{{"shape", "legend_shape"},
+                                  {"fill", "legend_fill"},
+                                  {"stroke", "legend_stroke"},
+                                  {"strokeDash", "legend_dash"},
+                                  {"orient", "top"},
+                                  {"direction", "horizontal"},
+                                  {"symbolStrokeWidth", 1.5},
+                                  {"symbolSize", 80}}});
+}
+
+void xScaleAndAxes(json& spec, const std::string& y_title) {
+  spec["scales"].push_back({{"name", "x"}, {"type", "linear"}, {"range", "width"}, {"zero", false},
+                            {"nice", false}, {"domain", {{"data", "series"}, {"field", "t_h"}}}});
+  spec["axes"] = json::array({{{"orient", "bottom"}, {"scale", "x"}, {"title", "time (h)"}, {"tickCount", 10}},
+                              {{"orient", "left"}, {"scale", "y"}, {"title", y_title}, {"grid", true}, {"tickCount", 6},
+                               {"minExtent", 40}}});
+}
+
+json xy(const char* y_field) {
+  return {{"x", {{"scale", "x"}, {"field", "t_h"}}}, {"y", {{"scale", "y"}, {"field", y_field}}}};
+}
+
+json linePlotMark(const char* data, const char* y_field, const char* colour, bool dashed) {
+  json enter = xy(y_field);
+  enter["stroke"] = {{"value", colour}};
+  enter["strokeWidth"] = {{"value", 1.5}};
+  if (dashed) enter["strokeDash"] = {{"value", json::array({6, 4})}};
+  return {{"type", "line"}, {"from", {{"data", data}}}, {"encode", {{"enter", enter}}}};
+}
+
+json bandMark(const char* data) {
+  return {{"type", "area"},
+          {"from", {{"data", data}}},
+          {"encode", {{"enter", {{"x", {{"scale", "x"}, {"field", "t_h"}}},
+                                 {"y", {{"scale", "y"}, {"field", "lo"}}},
+                                 {"y2", {{"scale", "y"}, {"field", "hi"}}},
+                                 {"fill", {{"value", kBandColour}}}}}}}};
+}
+
+// Plot 1: measured points, model line with its ±U band, "before" dashed, time in hours.
+json fitPlotSpec(const ChannelName& n, const SeriesData& d, const std::optional<Window>& validation) {
+  json spec = baseSpec(n.id + ": measured, model with its \u00b1U band" +
+                           std::string(d.has_before ? ", model before" : "") + ", against time in hours",
+                       240);
+  spec["data"] = json::array({seriesDataset(d)});
+  spec["data"].push_back({{"name", "measured"}, {"source", "series"},
+                          {"transform", json::array({filterTx("isValid(datum.measured)")})}});
+  spec["data"].push_back({{"name", "model"}, {"source", "series"},
+                          {"transform", json::array({filterTx("isValid(datum.predicted)")})}});
+  spec["data"].push_back({{"name", "band"}, {"source", "series"},
+                          {"transform", json::array({filterTx("isValid(datum.predicted) && isValid(datum.U)"),
+                                                     formulaTx("lo", "datum.predicted - datum.U"),
+                                                     formulaTx("hi", "datum.predicted + datum.U")})}});
+  if (d.has_before)
+    spec["data"].push_back({{"name", "before"}, {"source", "series"},
+                            {"transform", json::array({filterTx("isValid(datum.before)")})}});
+  spec["marks"] = json::array();
+  spec["scales"] = json::array();
+  addValidationWindow(spec, validation);
+
+  json y_fields = json::array({{{"data", "measured"}, {"field", "measured"}},
+                               {{"data", "model"}, {"field", "predicted"}}});
+  if (d.has_U) {
+    y_fields.push_back({{"data", "band"}, {"field", "lo"}});
+    y_fields.push_back({{"data", "band"}, {"field", "hi"}});
+  }
+  if (d.has_before) y_fields.push_back({{"data", "before"}, {"field", "before"}});
+  xScaleAndAxes(spec, axisTitle(n, ""));
+  spec["scales"].push_back({{"name", "y"}, {"type", "linear"}, {"range", "height"}, {"zero", false},
+                            {"nice", true}, {"domain", {{"fields", y_fields}}}});
+
+  spec["marks"].push_back(bandMark("band"));
+  if (d.has_before) spec["marks"].push_back(linePlotMark("before", "before", kBeforeColour, true));
+  spec["marks"].push_back(linePlotMark("model", "predicted", kModelColour, false));
+  json points = xy("measured");
+  points["shape"] = {{"value", "circle"}};
+  points["size"] = {{"value", 12}};
+  points["fill"] = {{"value", kMeasuredColour}};
+  points["fillOpacity"] = {{"value", 0.8}};
+  spec["marks"].push_back({{"type", "symbol"}, {"from", {{"data", "measured"}}}, {"encode", {{"enter", points}}}});
+
+  const json solid = json::array({1, 0});
+  std::vector<LegendEntry> legend{{"measured", "circle", kMeasuredColour, "transparent", solid},
+                                  {"model", "stroke", "transparent", kModelColour, solid}};
+  if (d.has_U) legend.push_back({"model \u00b1 U", "square", kBandColour, kBandColour, solid});
+  if (d.has_before) legend.push_back({"model before", "stroke", "transparent", kBeforeColour, json::array({6, 4})});
+  addLegend(spec, legend);
+  return spec;
+}
+
+// Plot 2: residual = measured − model, with the ±U band about zero; points beyond U in red.
+json residualPlotSpec(const ChannelName& n, const SeriesData& d, const std::optional<Window>& validation) {
+  json spec = baseSpec(n.id + ": residual (measured \u2212 model) with the \u00b1U band, against time in hours", 150);
+  spec["data"] = json::array({seriesDataset(d)});
+  spec["data"].push_back(
+      {{"name", "residual"}, {"source", "series"},
+       {"transform", json::array({filterTx("isValid(datum.measured) && isValid(datum.predicted)"),
+                                  formulaTx("residual", "datum.measured - datum.predicted"),
+                                  formulaTx("beyond", "isValid(datum.U) && abs(datum.residual) > datum.U")})}});
+  spec["data"].push_back({{"name", "band"}, {"source", "series"},
+                          {"transform", json::array({filterTx("isValid(datum.U)"), formulaTx("lo", "-datum.U"),
+                                                     formulaTx("hi", "datum.U")})}});
+  spec["marks"] = json::array();
+  spec["scales"] = json::array();
+  addValidationWindow(spec, validation);
+
+  json y_fields = json::array({{{"data", "residual"}, {"field", "residual"}}});
+  if (d.has_U) {
+    y_fields.push_back({{"data", "band"}, {"field", "lo"}});
+    y_fields.push_back({{"data", "band"}, {"field", "hi"}});
+  }
+  xScaleAndAxes(spec, axisTitle(n, "residual "));
+  spec["scales"].push_back({{"name", "y"}, {"type", "linear"}, {"range", "height"}, {"zero", true},
+                            {"nice", true}, {"domain", {{"fields", y_fields}}}});
+
+  spec["marks"].push_back(bandMark("band"));
+  spec["marks"].push_back({{"type", "rule"},
+                           {"encode", {{"enter", {{"x", {{"value", 0}}},
+                                                  {"x2", {{"signal", "width"}}},
+                                                  {"y", {{"scale", "y"}, {"value", 0}}},
+                                                  {"stroke", {{"value", "#999999"}}},
+                                                  {"strokeWidth", {{"value", 1}}}}}}}});
+  json points = xy("residual");
+  points["shape"] = {{"value", "circle"}};
+  points["size"] = {{"value", 12}};
+  points["fill"] = json::array({{{"test", "datum.beyond"}, {"value", kBeyondColour}}, {{"value", kMeasuredColour}}});
+  points["fillOpacity"] = {{"value", 0.8}};
+  spec["marks"].push_back({{"type", "symbol"}, {"from", {{"data", "residual"}}}, {"encode", {{"enter", points}}}});
+
+  const json solid = json::array({1, 0});
+  std::vector<LegendEntry> legend{{"residual", "circle", kMeasuredColour, "transparent", solid}};
+  if (d.has_U) {
+    legend.push_back({"|residual| > U", "circle", kBeyondColour, "transparent", solid});
+    legend.push_back({"\u00b1 U", "square", kBandColour, kBandColour, solid});
+  }
+  addLegend(spec, legend);
+  return spec;
+}
+
+// ---------------------------------------------------------------------------------------
+// The Vega runtime, inlined.
+
+// Debian's libjs-vega: one UMD build per module and no single bundle. These are the modules
+// the report's specs need (no geo/projection, which would need d3 modules Debian does not
+// ship with it), in an order where every module comes after the ones it requires. The first
+// name is what the modules `require`; vega-functions asks for "vega-selections".
+struct VegaModule {
+  const char* name;
+  const char* file;
+};
+constexpr VegaModule kVegaModules[] = {
+    {"vega-util", "vega-util.min.js"},
+    {"vega-canvas", "vega-canvas.min.js"},
+    {"vega-statistics", "vega-statistics.min.js"},
+    {"vega-time", "vega-time.min.js"},
+    {"vega-format", "vega-format.min.js"},
+    {"vega-loader", "vega-loader.min.js"},
+    {"vega-dataflow", "vega-dataflow.min.js"},
+    {"vega-scale", "vega-scale.min.js"},
+    {"vega-scenegraph", "vega-scenegraph.min.js"},
+    {"vega-expression", "vega-expression.min.js"},
+    {"vega-selections", "vega-selection.min.js"},
+    {"vega-functions", "vega-functions.min.js"},
+    {"vega-event-selector", "vega-event-selector.min.js"},
+    {"vega-parser", "vega-parser.min.js"},
+    {"vega-runtime", "vega-runtime.min.js"},
+    {"vega-view", "vega-view.min.js"},
+    {"vega-transforms", "vega-transforms.min.js"},
+    {"vega-view-transforms", "vega-view-transforms.min.js"},
+    {"vega-encode", "vega-encode.min.js"},
+};
+
+std::string readFile(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  if (!in) throw InputError(p.string(), 0, std::string("cannot read the Vega JavaScript; ") + kVegaInstallHint);
+  std::ostringstream s;
+  s << in.rdbuf();
+  std::string content = s.str();
+  if (content.empty()) throw InputError(p.string(), 0, std::string("the Vega JavaScript is empty; ") + kVegaInstallHint);
+  return content;
+}
+
+// Script text that cannot end its <script> element: "</script" and "<!--" only occur in
+// string or regular-expression literals of minified code, where \x3C means the same "<".
+std::string scriptSafe(std::string js) {
+  const auto replaceAll = [&js](const std::string& from_lower, const std::string& to) {
+    std::string lower = js;
+    std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+    for (std::size_t pos = lower.rfind(from_lower); pos != std::string::npos;
+         pos = pos == 0 ? std::string::npos : lower.rfind(from_lower, pos - 1))
+      js.replace(pos, 1, to);
+  };
+  replaceAll("</script", "\\x3C");
+  replaceAll("<!--", "\\x3C");
+  return js;
+}
+
+// The trailing "//# sourceMappingURL=..." would make a browser's developer tools look for a
+// file next to the page.
+std::string dropSourceMap(std::string js) {
+  const std::size_t pos = js.rfind("//# sourceMappingURL=");
+  if (pos == std::string::npos) return js;
+  const std::size_t eol = js.find('\n', pos);
+  if (eol == std::string::npos || js.find_first_not_of(" \t\r\n", eol) == std::string::npos) js.erase(pos);
+  return js;
+}
+
+std::string vegaRuntime(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path p(path);
+  if (fs::is_regular_file(p, ec)) return scriptSafe(readFile(p));
+  if (!fs::is_directory(p, ec))
+    throw InputError(path, 0, std::string("Vega JavaScript not found; ") + kVegaInstallHint);
+  std::string js =
+      "/* Vega 5, from the per-module builds of Debian's libjs-vega, behind a CommonJS shim. */\n"
+      "(function () {\n"
+      "var M = {};\n"
+      "function R(name) { if (!(name in M)) throw new Error('Vega module not loaded: ' + name); return M[name]; }\n";
+  for (const auto& m : kVegaModules) {
+    const fs::path file = p / m.file;
+    if (!fs::is_regular_file(file, ec))
+      throw InputError(file.string(), 0, std::string("Vega module missing; ") + kVegaInstallHint);
+    js += "/* " + std::string(m.file) + " */\n(function (exports, module, require) {\n" +
+          dropSourceMap(readFile(file)) + "\n})(M['" + m.name + "'] = {}, {}, R);\n";
+  }
+  // The namespace the upstream bundle (packages/vega/index.js) exports, as far as a page
+  // that parses and views specs needs it, and the same transform registry.
+  js += R"JS(var vega = {};
+['vega-statistics', 'vega-time', 'vega-util', 'vega-loader', 'vega-scenegraph'].forEach(function (n) { Object.assign(vega, M[n]); });
+var df = M['vega-dataflow'];
+['Dataflow', 'EventStream', 'Parameters', 'Pulse', 'MultiPulse', 'Operator', 'Transform', 'changeset', 'ingest',
+ 'isTuple', 'definition', 'transform', 'transforms', 'tupleid'].forEach(function (n) { vega[n] = df[n]; });
+M['vega-util'].extend(df.transforms, M['vega-transforms'], M['vega-view-transforms'], M['vega-encode']);
+['scale', 'scheme', 'interpolate', 'interpolateColors', 'interpolateRange'].forEach(function (n) { vega[n] = M['vega-scale'][n]; });
+vega.View = M['vega-view'].View;
+vega.parse = M['vega-parser'].parse;
+vega.expressionFunction = M['vega-functions'].expressionFunction;
+vega.formatLocale = M['vega-format'].formatLocale;
+vega.timeFormatLocale = M['vega-format'].timeFormatLocale;
+window.vega = vega;
+})();
+)JS";
+  return scriptSafe(js);
+}
+
+// Runs first: every later script error lands in #vega-errors.
+constexpr const char* kErrorHook = R"JS(
+window.probeloopReportError = function (where, e) {
+  var p = document.createElement('p');
+  p.textContent = where + ': ' + (e && e.message ? e.message : String(e));
+  document.getElementById('vega-errors').appendChild(p);
+};
+window.addEventListener('error', function (e) { window.probeloopReportError('script error', e.message); });
+window.addEventListener('unhandledrejection', function (e) { window.probeloopReportError('script error', e.reason); });
+)JS";
+
+// Runs last: renders every plot as SVG; Vega's errors (parse, dataflow) go to #vega-errors.
+constexpr const char* kRender = R"JS(
+(function () {
+  var report = window.probeloopReportError;
+  if (typeof vega === 'undefined' || typeof vega.View !== 'function') {
+    report('report', 'the Vega runtime did not load');
+    return;
+  }
+  Array.prototype.forEach.call(document.querySelectorAll('div.vega-plot'), function (div) {
+    var base = vega.logger(vega.Warn);
+    var logger = {
+      level: function (l) { if (arguments.length) { base.level(l); return logger; } return base.level(); },
+      error: function () { report(div.id, Array.prototype.join.call(arguments, ' ')); return logger; },
+      warn: function () { base.warn.apply(base, arguments); return logger; },
+      info: function () { base.info.apply(base, arguments); return logger; },
+      debug: function () { base.debug.apply(base, arguments); return logger; }
+    };
+    try {
+      var spec = JSON.parse(document.getElementById(div.id + '-spec').textContent);
+      new vega.View(vega.parse(spec), {renderer: 'svg', container: div, hover: false, logger: logger})
+        .runAsync()
+        .then(function () { div.setAttribute('data-rendered', 'true'); },
+              function (e) { report(div.id, e); });
+    } catch (e) {
+      report(div.id, e);
+    }
+  });
+})();
+)JS";
+
+constexpr const char* kStyle = R"CSS(
+body { font: 14px/1.45 system-ui, -apple-system, "Segoe UI", Roboto, sans-serif; color: #222; max-width: 1000px; margin: 2em auto; padding: 0 1em; }
+h1 { font-size: 1.5em; margin: 0 0 .4em; }
+h2 { font-size: 1.2em; margin: 2.2em 0 .5em; padding-bottom: .2em; border-bottom: 1px solid #ddd; }
+h3 { font-size: 1em; margin: 1.3em 0 .3em; }
+table { border-collapse: collapse; margin: .3em 0 1em; }
+th, td { padding: .25em .7em; border-bottom: 1px solid #e4e4e4; text-align: left; vertical-align: top; }
+th { font-weight: 600; background: #f6f6f6; }
+td.num, th.num { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
+table.meta th { background: none; font-weight: normal; color: #555; }
+.before { color: #777; }
+.new { font-size: .8em; background: #e3f0e3; color: #256325; padding: 0 .35em; border-radius: 3px; }
+.note { color: #555; }
+.verdict { font-size: 1.05em; }
+figure { margin: .6em 0; }
+figcaption { font-size: .85em; color: #555; }
+pre { background: #f4f4f4; padding: .4em .6em; margin: .4em 0 0; overflow-x: auto; }
+code { font-family: ui-monospace, "DejaVu Sans Mono", monospace; font-size: .9em; }
+td.rank { font-weight: 600; text-align: center; }
+tbody.candidate { border-top: 2px solid #ccc; }
+.errors { border: 1px solid #c0392b; background: #fdecea; color: #8e2a1f; padding: .5em 1em; margin: 1em 0; }
+.errors:empty { display: none; }
+)CSS";
+
+// ---------------------------------------------------------------------------------------
+// HTML.
+
+class Page {
+ public:
+  std::string html;
+  int plots = 0;
+
+  void plot(const json& spec, const std::string& caption) {
+    const std::string id = "plot-" + std::to_string(++plots);
+    html += "<figure>\n<div class=\"vega-plot\" id=\"" + id + "\"></div>\n<script type=\"application/json\" id=\"" +
+            id + "-spec\">" + scriptJson(spec) + "</script>\n<figcaption>" + esc(caption) + "</figcaption>\n</figure>\n";
+  }
+};
+
+std::string th(const std::string& s, bool num = false) {
+  return std::string(num ? "<th class=\"num\">" : "<th>") + esc(s) + "</th>";
+}
+// `html` is already markup.
+std::string tdHtml(const std::string& html, bool num = false) {
+  return std::string(num ? "<td class=\"num\">" : "<td>") + html + "</td>";
+}
+std::string td(const std::string& s, bool num = false) { return tdHtml(esc(s), num); }
+
+std::string spanText(const std::optional<Window>& w, const json& s) {
+  if (!w && s.empty()) return kDash;
+  std::string t = w ? hours(w->from_s) + " \u2013 " + hours(w->to_s) + " h" : kDash;
+  if (const auto n = number(s, "samples")) t += " (" + whole(*n) + " samples)";
+  return t;
+}
+
+void filesTable(Page& page, const json& fit, const json* diagnosis) {
+  page.html += "<table class=\"meta\">\n";
+  const auto row = [&page](const std::string& name, const std::string& value) {
+    page.html += "<tr>" + th(name) + td(value.empty() ? kDash : value) + "</tr>\n";
+  };
+  row("model", text(fit, "model"));
+  row("inputs", text(fit, "inputs"));
+  row("errors", text(fit, "errors"));
+  row("training", spanText(span(fit, "training"), object(fit, "training")));
+  row("validation", spanText(span(fit, "validation"), object(fit, "validation")));
+  if (diagnosis != nullptr) {
+    const std::string dm = text(*diagnosis, "model");
+    if (!dm.empty() && dm != text(fit, "model")) row("model of the diagnosis", dm);
+    if (const auto n = number(*diagnosis, "candidates_tried")) row("candidate fits tried", whole(*n));
+  }
+  page.html += "</table>\n";
+}
+
+struct IndicatorColumn {
+  const char* key;
+  const char* title;
+  bool channel_unit;  // else percent
+  int digits;
+};
+constexpr IndicatorColumn kIndicatorColumns[] = {
+    {"rmse", "RMSE", true, 3},
+    {"smape_percent", "SMAPE (%)", false, 3},
+    {"pv_ratio_percent", "PV ratio (%)", false, 3},
+    {"p99", "P99", true, 3},
+};
+
+void indicatorTable(Page& page, const json& channel, const ChannelName& n) {
+  const json& after = object(channel, "indicators");
+  const json* before_obj = field(channel, "before");
+  const bool has_before = before_obj != nullptr && before_obj->is_object();
+  static const json none = json::object();
+  const json& before = has_before ? object(*before_obj, "indicators") : none;
+  const std::string unit = n.unit.empty() ? "" : " (" + n.unit + ")";
+  std::string rows;
+  for (const char* set : {"training", "validation"}) {
+    const json& a = object(after, set);
+    const json& b = object(before, set);
+    if (a.empty() && b.empty()) continue;
+    rows += "<tr>" + th(set) + td(whole(number(a, "n")), true);
+    for (const auto& c : kIndicatorColumns) {
+      const std::string av = sig(number(a, c.key), c.digits);
+      rows += has_before ? tdHtml(beforeAfter(sig(number(b, c.key), c.digits), av), true) : td(av, true);
+    }
+    rows += "</tr>\n";
+  }
+  page.html += "<h3>Quality indicators" + std::string(has_before ? ", before \u2192 after" : "") + "</h3>\n";
+  if (rows.empty()) {
+    page.html += "<p class=\"note\">No indicators in the input.</p>\n";
+    return;
+  }
+  page.html += "<table class=\"indicators\">\n<thead><tr>" + th("data") + th("n", true);
+  for (const auto& c : kIndicatorColumns)
+    page.html += th(std::string(c.title) + (c.channel_unit ? unit : ""), true);
+  page.html += "</tr></thead>\n<tbody>\n" + rows + "</tbody>\n</table>\n";
+}
+
+void parameterTable(Page& page, const json& channel) {
+  const json& effects = array(channel, "effects");
+  page.html += "<h3>Effects and parameters</h3>\n";
+  if (effects.empty()) {
+    page.html += "<p class=\"note\">No effects listed.</p>\n";
+    return;
+  }
+  page.html += "<table class=\"parameters\">\n<thead><tr>" + th("effect") + th("kind") + th("input") + th("parameter") +
+               th("value \u00b1 u", true) + th("unit") + "</tr></thead>\n<tbody>\n";
+  for (const auto& e : effects) {
+    const json& params = array(e, "parameters");
+    const std::size_t rows = std::max<std::size_t>(1, params.size());
+    const std::string rs = rows > 1 ? " rowspan=\"" + std::to_string(rows) + "\"" : "";
+    const bool added = boolean(e, "just_added").value_or(false);
+    const std::string input = text(e, "input");
+    page.html += "<tr><td" + rs + ">" + esc(text(e, "id")) + (added ? " <span class=\"new\">just added</span>" : "") +
+                 "</td><td" + rs + ">" + esc(text(e, "kind")) + "</td><td" + rs + ">" +
+                 esc(input.empty() ? kDash : input) + "</td>";
+    if (params.empty()) page.html += td(kDash) + td(kDash, true) + td("") + "</tr>\n";
+    for (std::size_t i = 0; i < params.size(); ++i) {
+      const json& p = params[i];
+      if (i > 0) page.html += "<tr>";
+      page.html += td(text(p, "name")) + td(valueU(number(p, "value"), number(p, "u")), true) +
+                   td(displayUnit(text(p, "unit"))) + "</tr>\n";
+    }
+  }
+  page.html += "</tbody>\n</table>\n";
+}
+
+std::string yesNo(const std::optional<bool>& b) { return b ? (*b ? "yes" : "no") : kDash; }
+
+void channelDiagnosis(Page& page, const json& d, const ChannelName& n) {
+  const std::string unit = n.unit.empty() ? "" : " (" + n.unit + ")";
+  const json& rms = object(d, "rms_residual");
+  const json& lb = object(d, "ljung_box");
+  // One quantity per row: the names are long, the values short.
+  page.html += "<h3>Diagnosis of the residual</h3>\n<table class=\"diagnosis\">\n<tbody>\n";
+  const auto row = [&page](const std::string& name, const std::string& value) {
+    page.html += "<tr>" + th(name) + td(value, true) + "</tr>\n";
+  };
+  row("RMS residual, training" + unit, sig(number(rms, "training"), 3));
+  row("RMS residual, validation" + unit, sig(number(rms, "validation"), 3));
+  row("standard uncertainty of measurement" + unit, sig(number(d, "u_measurement"), 3));
+  if (boolean(d, "within")) row("RMS residual within the measurement uncertainty", yesNo(boolean(d, "within")));
+  row("Ljung\u2013Box Q (" + whole(number(lb, "lags")) + " lags)", sig(number(lb, "Q"), 4));
+  row("Ljung\u2013Box p", sig(number(lb, "p"), 2));
+  row("residual white", yesNo(boolean(d, "white")));
+  page.html += "</tbody>\n</table>\n";
+
+  const json& windows = array(d, "windows");
+  constexpr std::size_t kMaxWindows = 10;
+  if (windows.empty()) {
+    page.html += "<p class=\"note\">No time window where |residual| exceeds U.</p>\n";
+  } else {
+    page.html += "<h3>Windows where |residual| &gt; U</h3>\n<table class=\"windows\">\n<thead><tr>" +
+                 th("from (h)", true) + th("to (h)", true) + th("peak |residual|" + unit, true) + th("samples", true) +
+                 "</tr></thead>\n<tbody>\n";
+    for (std::size_t i = 0; i < std::min(windows.size(), kMaxWindows); ++i) {
+      const json& w = windows[i];
+      page.html += "<tr>" + td(hours(number(w, "from_s")), true) + td(hours(number(w, "to_s")), true) +
+                   td(sig(number(w, "peak"), 3), true) + td(whole(number(w, "samples")), true) + "</tr>\n";
+    }
+    page.html += "</tbody>\n</table>\n";
+    if (windows.size() > kMaxWindows)
+      page.html += "<p class=\"note\">\u2026 and " + std::to_string(windows.size() - kMaxWindows) + " more windows.</p>\n";
+  }
+
+  // The strongest first (stable: ties keep the input's order).
+  const json& cross = array(d, "cross_correlation");
+  std::vector<const json*> cc;
+  for (const auto& c : cross) cc.push_back(&c);
+  const auto strength = [](const json* c) { return std::abs(number(*c, "r").value_or(0.0)); };
+  std::stable_sort(cc.begin(), cc.end(), [&](const json* a, const json* b) { return strength(a) > strength(b); });
+  constexpr std::size_t kMaxCross = 5;
+  if (!cc.empty()) {
+    page.html += "<h3>Strongest cross-correlations of the residual with the inputs</h3>\n<table class=\"cross\">\n<thead><tr>" +
+                 th("input") + th("lag (s)", true) + th("lag (h)", true) + th("r", true) + th("significant") +
+                 "</tr></thead>\n<tbody>\n";
+    for (std::size_t i = 0; i < std::min(cc.size(), kMaxCross); ++i) {
+      const json& c = *cc[i];
+      const auto lag = number(c, "lag_s");
+      page.html += "<tr>" + td(text(c, "input")) + td(whole(lag), true) + td(hours(lag), true) +
+                   td(number(c, "r") ? fixed(*number(c, "r"), 2) : kDash, true) + td(yesNo(boolean(c, "significant"))) +
+                   "</tr>\n";
+    }
+    page.html += "</tbody>\n</table>\n";
+  }
+}
+
+const json* findChannel(const json* diagnosis, const std::string& id) {
+  if (diagnosis == nullptr) return nullptr;
+  for (const auto& c : array(*diagnosis, "channels"))
+    if (text(c, "channel") == id) return &c;
+  return nullptr;
+}
+
+std::string verdictText(const std::string& v) {
+  if (v == "missing") return "an effect is missing from the model";
+  if (v == "nothing_missing") return "nothing is missing: the residual is within the measurement uncertainty";
+  if (v == "unexplained") return "the residual has structure that no candidate effect explains";
+  return v.empty() ? kDash : v;
+}
+
+void candidatesTable(Page& page, const json& diagnosis) {
+  const json& cands = array(diagnosis, "candidates");
+  page.html += "<h3>Candidate effects, ranked</h3>\n";
+  if (cands.empty()) {
+    page.html += "<p class=\"note\">No candidate effect improves the model.</p>\n";
+    return;
+  }
+  page.html += "<table class=\"candidates\">\n<thead><tr>" + th("rank") + th("channel") +
+               th("validation RMSE, before \u2192 after", true) + th("MDL, before \u2192 after", true) +
+               th("parameters of the effect") + "</tr></thead>\n";
+  for (std::size_t k = 0; k < cands.size(); ++k) {
+    const json& c = cands[k];
+    const json& chans = array(c, "channels");
+    const std::size_t rows = std::max<std::size_t>(1, chans.size()) + 1;
+    std::string name = text(c, "id");
+    if (name.empty()) {
+      name = text(c, "effect");
+      const std::string input = text(c, "input");
+      if (!input.empty()) name += "(" + input + ")";
+    }
+    const auto rank = number(c, "rank");
+    page.html += "<tbody class=\"candidate\">\n<tr><td class=\"rank\" rowspan=\"" + std::to_string(rows) + "\">" +
+                 esc(rank ? whole(*rank) : std::to_string(k + 1)) + "</td><td colspan=\"4\"><strong>" +
+                 esc(name.empty() ? kDash : name) + "</strong>";
+    if (const auto score = number(c, "score")) page.html += " <span class=\"note\">(score " + esc(sig(*score, 3)) + ")</span>";
+    page.html += "<p class=\"sentence\">" + esc(text(c, "sentence")) + "</p>";
+    const std::string command = text(c, "command");
+    if (!command.empty()) page.html += "<pre><code>" + esc(command) + "</code></pre>";
+    page.html += "</td></tr>\n";
+    if (chans.empty()) page.html += "<tr>" + td(kDash) + td(kDash, true) + td(kDash, true) + td(kDash) + "</tr>\n";
+    for (const auto& ch : chans) {
+      const std::string id = text(ch, "channel");
+      std::string unit;
+      if (const json* fc = findChannel(&diagnosis, id)) unit = displayUnit(text(*fc, "unit"));
+      std::string params;
+      for (const auto& p : array(ch, "parameters")) {
+        if (!params.empty()) params += "<br>";
+        params += esc(text(p, "name") + " = " + withUnit(valueU(number(p, "value"), number(p, "u")),
+                                                          displayUnit(text(p, "unit"))));
+      }
+      page.html += "<tr>" + td(id) +
+                   tdHtml(beforeAfter(sig(number(ch, "validation_rmse_before"), 3),
+                                      withUnit(sig(number(ch, "validation_rmse_after"), 3), unit)),
+                          true) +
+                   tdHtml(beforeAfter(sig(number(ch, "mdl_before"), 3), sig(number(ch, "mdl_after"), 3)), true) +
+                   tdHtml(params.empty() ? kDash : params) + "</tr>\n";
+    }
+    page.html += "</tbody>\n";
+  }
+  page.html += "</table>\n";
+}
+
+void checkKind(const json& j, const char* expected, const char* what) {
+  if (!j.is_object())
+    throw InputError("", 0, std::string("model report: the ") + what + " is not a JSON object (expected the output of `" +
+                                expected + " --json`)");
+  const json* kind = field(j, "kind");
+  if (kind != nullptr && kind->is_string() && kind->get<std::string>() != expected)
+    throw InputError("", 0, std::string("model report: the ") + what + " has kind \"" + kind->get<std::string>() +
+                                "\", expected \"" + expected + "\"");
+}
+
+}  // namespace
+
+std::string defaultVegaPath() { return "/usr/share/javascript/vega"; }
+
+std::string modelReportHtml(const json& fit, const json* diagnosis, const std::string& vega_js_path) {
+  checkKind(fit, "probeloop model fit", "fit");
+  if (diagnosis != nullptr) checkKind(*diagnosis, "probeloop model diagnose", "diagnosis");
+  const json* channels = field(fit, "channels");
+  if (channels == nullptr || !channels->is_array())
+    throw InputError("", 0, "model report: the fit has no \"channels\" array (expected the output of `probeloop model fit --json`)");
+  const std::string vega = vegaRuntime(vega_js_path);  // first: a missing runtime is an error whatever the data
+  const std::optional<Window> validation = span(fit, "validation");
+
+  Page page;
+  page.html += "<header>\n<h1>Error model fit" + std::string(diagnosis ? " and diagnosis" : "") + "</h1>\n";
+  filesTable(page, fit, diagnosis);
+  page.html += "</header>\n<div id=\"vega-errors\" class=\"errors\" role=\"alert\"></div>\n<script>" +
+               std::string(kErrorHook) + "</script>\n";
+
+  if (diagnosis != nullptr) {
+    const std::string verdict = text(*diagnosis, "verdict");
+    page.html += "<section class=\"diagnosis\">\n<h2>Diagnosis</h2>\n<p class=\"verdict\">Verdict: <strong>" +
+                 esc(verdictText(verdict)) + "</strong></p>\n";
+    const std::string message = text(*diagnosis, "message");
+    if (!message.empty()) page.html += "<p class=\"message\">" + esc(message) + "</p>\n";
+    candidatesTable(page, *diagnosis);
+    page.html += "</section>\n";
+  }
+
+  std::vector<std::string> shown;
+  for (const auto& c : *channels) {
+    const ChannelName n = channelName(c);
+    shown.push_back(n.id);
+    page.html += "<section class=\"channel\">\n<h2>" + esc(axisTitle(n, "")) + "</h2>\n<p class=\"summary\">";
+    std::string facts;
+    const auto fact = [&facts](const std::string& s) { facts += (facts.empty() ? "" : " \u00b7 ") + s; };
+    if (const auto u = number(c, "u_measurement")) fact("u of measurement = " + withUnit(sig(*u, 3), n.unit));
+    if (const auto s = number(c, "sigma")) fact("residual \u03c3 (fit) = " + withUnit(sig(*s, 3), n.unit));
+    std::string effects;
+    for (const auto& e : array(c, "effects")) effects += (effects.empty() ? "" : ", ") + text(e, "id");
+    fact("effects: " + (effects.empty() ? kDash : effects));
+    const json* before = field(c, "before");
+    if (before != nullptr && before->is_object()) {
+      std::string b;
+      for (const auto& e : array(*before, "effects")) b += (b.empty() ? "" : ", ") + (e.is_string() ? e.get<std::string>() : e.dump());
+      fact("before: " + (b.empty() ? kDash : b));
+    }
+    page.html += esc(facts) + "</p>\n";
+
+    const SeriesData d = seriesData(object(c, "series"));
+    if (d.rows.empty()) {
+      page.html += "<p class=\"note\">No series in the input: nothing to plot.</p>\n";
+    } else {
+      std::string cap = "Measured (points), model (line) and the band model \u00b1 U";
+      if (!d.has_U) cap = "Measured (points) and model (line); the input has no U, so no band";
+      if (d.has_before) cap += "; dashed: the model before the effects just added";
+      page.plot(fitPlotSpec(n, d, validation), cap + (validation ? "; shaded: validation window." : "."));
+      page.plot(residualPlotSpec(n, d, validation),
+                "Residual = measured \u2212 model" +
+                    std::string(d.has_U ? "; band \u00b1 U; red points: |residual| > U." : "; the input has no U."));
+    }
+    indicatorTable(page, c, n);
+    parameterTable(page, c);
+    if (const json* dc = findChannel(diagnosis, n.id)) channelDiagnosis(page, *dc, n);
+    page.html += "</section>\n";
+  }
+  if (diagnosis != nullptr) {
+    for (const auto& dc : array(*diagnosis, "channels")) {
+      const ChannelName n = channelName(dc);
+      if (std::find(shown.begin(), shown.end(), n.id) != shown.end()) continue;
+      page.html += "<section class=\"channel\">\n<h2>" + esc(axisTitle(n, "")) +
+                   " <span class=\"note\">(diagnosed, not in the fit)</span></h2>\n";
+      channelDiagnosis(page, dc, n);
+      page.html += "</section>\n";
+    }
+  }
+
+  std::string out =
+      "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+      "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<meta name=\"generator\" "
+      "content=\"probeloop\">\n<title>" +
+      esc("Error model fit" + std::string(diagnosis ? " and diagnosis" : "") +
+          (text(fit, "model").empty() ? "" : " \u2014 " + text(fit, "model"))) +
+      "</title>\n<style>" + kStyle + "</style>\n</head>\n<body>\n";
+  out += page.html;
+  out += "<script>\n" + vega + "\n</script>\n<script>" + kRender + "</script>\n</body>\n</html>\n";
+  return out;
+}
+
+}  // namespace probeloop::report

@@ -1,0 +1,175 @@
+#!/usr/bin/env python3
+"""Integration tests of `probeloop model` through the real CLI, on hidden-effect campaigns.
+
+Each campaign (tests/data/hidden/, run by hidden_campaign.sh: plan -> simulate -> evaluate
+with the real CLI) hides one effect from a starting model. The diagnosis must rank it first;
+the command it prints must add it; the next fit must bring the validation RMSE of the
+affected channels within 1.5x the measurement noise, where the noise is measured against
+the simulator's injected truth (truth.json), not taken from the code under test. One
+campaign hides nothing, and the answer must be "nothing missing". Then bad input, and the
+HTML report opened in headless Chromium. Needs $PROBELOOP and $PROBELOOP_SOURCE_DIR.
+"""
+import csv, json, math, os, shlex, subprocess, sys, tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402
+from html_render import check as render_check  # noqa: E402
+
+PL = os.environ["PROBELOOP"]
+SRC = os.environ["PROBELOOP_SOURCE_DIR"]
+W = tempfile.mkdtemp(prefix="probeloop-model-")
+CHANNELS = ["EX0C_um", "EY0C_um", "EZ0T_um", "ER0T_um", "EA0C_urad", "EB0C_urad", "EC0C_urad"]
+check = Checks()
+
+# name: (starting model effects per channel, expected top effect id, channels it must reach)
+CAMPAIGNS = {
+    "rotary_heat": ({}, "lag(c_rpm)", ["EY0C_um", "EZ0T_um"]),  # EA0C: at its noise (3 urad steps)
+    "door_step": ({}, "lag(T_env_C)", ["EZ0T_um"]),
+    "artifact_expansion": ({}, "expansion(T_table_C)", ["EZ0T_um", "ER0T_um"]),
+    "tool_change": ({}, "transient(tool_changes)", ["EZ0T_um"]),
+    "nothing_missing": ({"EZ0T_um": ["static:T_column_C"], "EY0C_um": ["static:T_column_C"]}, None, []),
+}
+
+
+def run(*args):
+    p = subprocess.run([PL, *args], capture_output=True, text=True)
+    return p.returncode, p.stdout, p.stderr
+
+
+def write_model(path, effects, data=True):
+    lines = ["kind: error_model"]
+    if data:
+        lines.append("data: {inputs: run/inputs.csv, errors: eval/errors.csv}")
+    lines.append("channels:")
+    for ch in CHANNELS:
+        eff = effects.get(ch, [])
+        items = ", ".join("{effect: %s, input: %s}" % tuple(e.split(":")) for e in eff)
+        lines.append(f"  {ch}: [{items}]")
+    open(path, "w").write("\n".join(lines) + "\n")
+
+
+def noise_rms(out, channel, from_s):
+    """The measurement noise as a model sees it, over the validation cycles: the standard
+    deviation of measured - injected truth, where the truth's tool-change (ATC) step is put
+    back into the noise: it is drawn anew at each change and no effect can predict it."""
+    rows = list(csv.DictReader(l for l in open(f"{out}/eval/errors.csv") if not l.startswith("#")))
+    t = json.load(open(f"{out}/run/truth.json"))
+    truth = {c["cycle"]: c for c in t["cycles"]}
+    axis = {"EX0C_um": 0, "EY0C_um": 1, "EZ0T_um": 2}.get(channel)
+    atc = {}
+    for e in t["events"]:
+        atc.setdefault(e["cycle"], []).append(e["atc_um"][axis] if axis is not None else 0.0)
+    d = []
+    for r in rows:
+        c = int(r["cycle"])
+        if float(r["time_s"]) >= from_s:
+            # apparent = ... - tool (tool includes the ATC step): add the step back.
+            d.append(float(r[channel]) - (truth[c][channel] + sum(atc[c]) / len(atc[c])))
+    m = sum(d) / len(d)
+    return math.sqrt(sum((x - m) ** 2 for x in d) / (len(d) - 1))
+
+
+for name, (start, expected, channels) in CAMPAIGNS.items():
+    out = f"{W}/{name}"
+    p = subprocess.run(["bash", f"{SRC}/tests/integration/hidden_campaign.sh", name, out], capture_output=True, text=True,
+                       env={**os.environ, "PROBELOOP": PL, "PROBELOOP_SOURCE_DIR": SRC})
+    if p.returncode != 0:
+        check(f"{name}: campaign runs", False, p.stderr)
+        continue
+    model = f"{out}/model.yaml"
+    write_model(model, start)
+    rc, text, err = run("model", "diagnose", model, "--part", f"{out}/artifact.yaml", "--json", f"{out}/diag.json")
+    if rc != 0:
+        check(f"{name}: diagnose runs", False, err)
+        continue
+    d = json.load(open(f"{out}/diag.json"))
+    if expected is None:
+        check(f"{name}: the verdict is 'nothing missing'", d["verdict"] == "nothing_missing" and not d["candidates"],
+              d["message"] + " | " + "; ".join(c["id"] for c in d["candidates"][:3]))
+        check(f"{name}: it says so in words", "Nothing is missing" in text, text[-400:])
+        continue
+    top = d["candidates"][0] if d["candidates"] else {}
+    check(f"{name}: {expected} ranks first", d["verdict"] == "missing" and top.get("id") == expected,
+          f"verdict {d['verdict']}; ranked: " + ", ".join(f"{c['id']} ({c['score']:.1f})" for c in d["candidates"][:4]))
+    if top.get("id") != expected:
+        continue
+    reached = [c["channel"] for c in top["channels"]]
+    check(f"{name}: it reaches {', '.join(channels)}", all(c in reached for c in channels), reached)
+    check(f"{name}: one sentence and the command are printed", top["sentence"] in text and top["command"] in text, text[-600:])
+    # The user copies the printed command.
+    cmd = shlex.split(top["command"])
+    check(f"{name}: the command is a probeloop command", cmd[0] == "probeloop", cmd)
+    rc, _, err = run(*cmd[1:])
+    check(f"{name}: the printed command adds the effect", rc == 0, err)
+    rc, text, err = run("model", "fit", model, "--json", f"{out}/fit.json")
+    if rc != 0:
+        check(f"{name}: the fit after adding runs", False, err)
+        continue
+    f = json.load(open(f"{out}/fit.json"))
+    check(f"{name}: the fit prints before and after side by side", "Before -> after" in text, text[-300:])
+    by = {c["channel"]: c for c in f["channels"]}
+    for ch in channels:
+        c = by[ch]
+        after = c["indicators"]["validation"]["rmse"]
+        before = c["before"]["indicators"]["validation"]["rmse"]
+        noise = noise_rms(out, ch, f["validation"]["from_s"])
+        check(f"{name}: {ch} validation RMSE {before:.2f} -> {after:.2f}, within 1.5x the noise {noise:.2f}",
+              after <= 1.5 * noise and after < before, f"after {after}, noise {noise}")
+
+# The HTML report of the last campaign with an added effect, opened in Chromium.
+out = f"{W}/door_step"
+if os.path.exists(f"{out}/model.yaml"):
+    rc, _, err = run("model", "fit", f"{out}/model.yaml", "--report", f"{out}/fit.html")
+    check("fit --report writes the HTML", rc == 0 and os.path.exists(f"{out}/fit.html"), err)
+    if rc == 0:
+        ok, detail = render_check(f"{out}/fit.html", 2 * len(CHANNELS))
+        check("the fit report's plots render in headless Chromium", ok, detail)
+    rc, _, err = run("model", "diagnose", f"{out}/model.yaml", "--report", f"{out}/diagnosis.html")
+    check("diagnose --report writes the HTML", rc == 0 and os.path.exists(f"{out}/diagnosis.html"), err)
+
+# Bad input: clear messages, nothing written.
+b = f"{W}/bad"
+os.makedirs(b, exist_ok=True)
+open(f"{b}/inputs.csv", "w").write("time_s,T_env_C\n0,20\n60,20.1\n120,nan\n")
+open(f"{b}/errors.csv", "w").write("time_s,cycle,EY0C_um,U_EY0C_um\n10,1,0,0\n100,2,1,2\n")
+open(f"{b}/m.yaml", "w").write("kind: error_model\nchannels:\n  EY0C_um: [{effect: lag, input: T_env_C}]\n")
+
+
+def refuses(label, pattern, *args):
+    rc, o, e = run(*args)
+    check(label, rc != 0 and pattern in e, f"rc={rc} err={e.strip()[:300]}")
+
+
+refuses("NaN in the inputs: file, line, column", "inputs.csv:4: field 'T_env_C': 'nan' is not a finite number",
+        "model", "fit", f"{b}/m.yaml", "--inputs", f"{b}/inputs.csv", "--errors", f"{b}/errors.csv")
+open(f"{b}/gap.csv", "w").write("time_s,T_env_C\n0,20\n60,20.1\n120,20.2\n600,20\n")
+refuses("a gap in the inputs", "gap.csv:5: gap in the inputs: 480 s since line 4",
+        "model", "fit", f"{b}/m.yaml", "--inputs", f"{b}/gap.csv", "--errors", f"{b}/errors.csv")
+open(f"{b}/late.csv", "w").write("time_s,T_env_C\n50,20\n110,20.1\n170,20.2\n")
+refuses("misaligned time bases", "misaligned time bases",
+        "model", "fit", f"{b}/m.yaml", "--inputs", f"{b}/late.csv", "--errors", f"{b}/errors.csv")
+refuses("no data named", "no data: give --inputs and --errors", "model", "fit", f"{b}/m.yaml")
+open(f"{b}/unknown.yaml", "w").write("kind: error_model\nchannels:\n  EY0C_um:\n    - {effect: magic, input: T_env_C}\n")
+refuses("an unknown effect: file and line", "unknown.yaml:4", "model", "fit", f"{b}/unknown.yaml")
+open(f"{b}/twice.yaml", "w").write("kind: error_model\nchannels:\n  EY0C_um:\n    - {effect: static, input: T}\n    - {effect: static, input: T}\n")
+refuses("the same effect twice", "static(T) is already in this channel", "model", "fit", f"{b}/twice.yaml")
+open(f"{b}/ok.csv", "w").write("time_s,T_env_C\n0,20\n60,20.1\n120,20.2\n")
+refuses("too short a training span: how many more samples", "more samples",
+        "model", "fit", f"{b}/m.yaml", "--inputs", f"{b}/ok.csv", "--errors", f"{b}/errors.csv")
+before = open(f"{b}/m.yaml").read()
+refuses("model add refuses a duplicate", "already has lag(T_env_C)",
+        "model", "add", "lag", "--model", f"{b}/m.yaml", "--channels", "EY0C_um", "--input", "T_env_C")
+check("a refused add leaves the file as it was", open(f"{b}/m.yaml").read() == before)
+refuses("expansion needs the artifact", "needs --part",
+        "model", "add", "expansion", "--model", f"{b}/m.yaml", "--channels", "EZ0T_um", "--input", "T_env_C")
+refuses("a drift reads no input", "a drift reads no input",
+        "model", "add", "drift", "--model", f"{b}/m.yaml", "--channels", "EY0C_um", "--input", "T_env_C")
+rc, _, err = run("model", "add", "static", "--model", f"{b}/m.yaml", "--channels", "EY0C_um, EZ0T_um", "--input", "T_env_C")
+text = open(f"{b}/m.yaml").read()
+check("model add trims the channel list and the file loads back",
+      rc == 0 and "\"EZ0T_um\":" in text and run("model", "fit", f"{b}/m.yaml")[2].find("no data") >= 0, err + text)
+open(f"{b}/noU.csv", "w").write("time_s,cycle,EY0C_um\n10,1,0\n100,2,1\n")
+open(f"{b}/m0.yaml", "w").write("kind: error_model\ntraining_fraction: 1\nchannels: {EY0C_um: []}\n")
+refuses("diagnose refuses a channel without U", "no expanded uncertainty",
+        "model", "diagnose", f"{b}/m0.yaml", "--inputs", f"{b}/ok.csv", "--errors", f"{b}/noU.csv")
+check.finish()
