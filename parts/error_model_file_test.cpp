@@ -47,7 +47,9 @@ TEST(ErrorModelFile, WhatIsWrittenLoadsBackTheSame) {
       const auto &a = m.channels[c].effects[k], &b = back.channels[c].effects[k];
       EXPECT_EQ(b.id(), a.id());
       EXPECT_EQ(b.tau_s.has_value(), a.tau_s.has_value());
-      if (a.tau_s) EXPECT_EQ(*b.tau_s, *a.tau_s);  // shortest round-trip decimal: exact
+      if (a.tau_s) {
+        EXPECT_EQ(*b.tau_s, *a.tau_s);  // shortest round-trip decimal: exact
+      }
       EXPECT_EQ(b.tau_fixed, a.tau_fixed);
       EXPECT_EQ(b.just_added, a.just_added);
       EXPECT_EQ(b.alpha_um_per_m_K, a.alpha_um_per_m_K);
