@@ -61,6 +61,8 @@ std::vector<Effect> candidatesFor(const Campaign& c, const ChannelModel& cm, con
       add(makeEffect(EffectKind::Transient, name));
     } else if (isSpeedInput(name) || endsWith(name, "_on")) {
       add(makeEffect(EffectKind::Lag, name));
+      // A feed also loads the cut: the force grows with it at once (seed 000 Eq. 3.16).
+      if (name.rfind("feed", 0) == 0) add(makeEffect(EffectKind::Static, name));
     } else {
       add(makeEffect(EffectKind::Static, name));
     }
@@ -79,8 +81,11 @@ std::string physics(const Effect& e) {
     case EffectKind::Transient:
       return "the machine settles after each tool change (a cold holder in the warm spindle); model it, or probe after it has settled";
     case EffectKind::Static:
-      return isTemperature(in) ? "the structure near that sensor expands with it, without delay"
-                               : "the error moves with " + in + " without delay";
+      if (isTemperature(in)) return "the structure near that sensor expands with it, without delay";
+      if (in.rfind("feed", 0) == 0)
+        return "the cutting force grows with the feed (F = k_c Q / v_c) and deflects the tool and the structure; "
+               "finish at a lower feed or compensate the deflection";
+      return "the error moves with " + in + " without delay";
     case EffectKind::Lag:
       if (isSpeedInput(in) && (in.rfind("c_", 0) == 0 || in.find("rotary") != std::string::npos))
         return "a heat source in the rotary (C) axis is missing (bearing and torque motor)";

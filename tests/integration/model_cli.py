@@ -2,7 +2,7 @@
 """Integration tests of `probeloop model` through the real CLI, on hidden-effect campaigns.
 
 Each campaign (tests/data/hidden/, run by hidden_campaign.sh: plan -> simulate -> evaluate
-with the real CLI) hides one effect from a starting model. The diagnosis must rank it first;
+with the real CLI; the machined part by force_feed_campaign.py: cut -> CMM -> plane fits) hides one effect from a starting model. The diagnosis must rank it first;
 the command it prints must add it; the next fit must bring the validation RMSE of the
 affected channels within 1.5x the measurement noise, where the noise is measured against
 the simulator's injected truth (truth.json), not taken from the code under test. One
@@ -115,6 +115,39 @@ for name, (start, expected, channels) in CAMPAIGNS.items():
         noise = noise_rms(out, ch, f["validation"]["from_s"])
         check(f"{name}: {ch} validation RMSE {before:.2f} -> {after:.2f}, within 1.5x the noise {noise:.2f}",
               after <= 1.5 * noise and after < before, f"after {after}, noise {noise}")
+
+# The force/feed campaign on a machined part: the wall of each segment, measured on the CMM.
+out = f"{W}/force_feed"
+p = subprocess.run([sys.executable, f"{SRC}/tests/integration/force_feed_campaign.py", out], capture_output=True, text=True,
+                   env={**os.environ, "PROBELOOP": PL, "PROBELOOP_SOURCE_DIR": SRC})
+check("force_feed: campaign runs (cut, CMM, plane fits)", p.returncode == 0, p.stderr)
+if p.returncode == 0:
+    open(f"{out}/model.yaml", "w").write(
+        "kind: error_model\ndata: {inputs: run/inputs.csv, errors: eval/errors.csv}\nchannels:\n  WALL_Y_um: []\n")
+    rc, text, err = run("model", "diagnose", f"{out}/model.yaml", "--json", f"{out}/diag.json")
+    d = json.load(open(f"{out}/diag.json")) if rc == 0 else {"verdict": err, "candidates": []}
+    top = d["candidates"][0] if d["candidates"] else {}
+    check("force_feed: static(feed_mm_per_min) ranks first", top.get("id") == "static(feed_mm_per_min)",
+          f"verdict {d['verdict']}; ranked: " + ", ".join(c["id"] for c in d["candidates"][:3]))
+    if top.get("id") == "static(feed_mm_per_min)":
+        check("force_feed: the sentence names the cutting force", "cutting force" in top["sentence"], top["sentence"])
+        cmd = shlex.split(top["command"])
+        rc, _, err = run(*cmd[1:])
+        rc2, _, err2 = run("model", "fit", f"{out}/model.yaml", "--json", f"{out}/fit.json")
+        if rc == 0 and rc2 == 0:
+            c = json.load(open(f"{out}/fit.json"))["channels"][0]
+            after, before = c["indicators"]["validation"]["rmse"], c["before"]["indicators"]["validation"]["rmse"]
+            # The CMM's noise: the scatter of the measured walls about a straight line in the
+            # simulator's injected deflection of each cut (cuts.json), independent of the model.
+            e = [float(r["WALL_Y_um"]) for r in csv.DictReader(l for l in open(f"{out}/eval/errors.csv") if not l.startswith("#"))]
+            t = [float(r["deflection_y_um"]) for r in csv.DictReader(open(f"{out}/truth_deflection.csv"))]
+            n, mt, me = len(e), sum(t) / len(t), sum(e) / len(e)
+            b = sum((x - mt) * (y - me) for x, y in zip(t, e)) / sum((x - mt) ** 2 for x in t)
+            noise = math.sqrt(sum((y - me - b * (x - mt)) ** 2 for x, y in zip(t, e)) / (n - 2))
+            check(f"force_feed: WALL_Y_um validation RMSE {before:.2f} -> {after:.2f}, within 1.5x the noise {noise:.2f}",
+                  after <= 1.5 * noise and after < before, f"after {after}, noise {noise}")
+        else:
+            check("force_feed: add and fit run", False, err + err2)
 
 # The HTML report of the last campaign with an added effect, opened in Chromium.
 out = f"{W}/door_step"
