@@ -20,7 +20,7 @@ bool endsWith(const std::string& s, const std::string& e) {
 class ChannelRegression {
  public:
   ChannelRegression(const Campaign& c, const std::string& channel, const std::vector<Effect>& effects, int train_end)
-      : c_(c), effects_(effects), n_(train_end) {
+      : c_(c), n_(train_end) {
     ch_ = c.errors.channel(channel);
     if (ch_ < 0) {
       std::string have;
@@ -32,10 +32,11 @@ class ChannelRegression {
     y_ = Eigen::Map<const Eigen::VectorXd>(c.errors.values[ch_].data(), N);
     fixed_ = Eigen::VectorXd::Zero(N);
     const double t_train_end = c.errors.t_s[std::max(0, n_ - 1)];
-    for (const auto& e : effects_) {
+    for (const auto& e : effects) {
       if (e.kind == EffectKind::Offset) continue;
       if (e.kind == EffectKind::Drift) {
         columns_.push_back(&e);
+        col_input_.push_back(-1);
         continue;
       }
       const int col = c.inputs.column(e.input);
@@ -54,19 +55,15 @@ class ChannelRegression {
         throw InputError(c.inputs.file, 0,
                          name_ + ": " + e.id() + ": input '" + e.input + "' is constant (" + formatNumber(lo) +
                              ") over the training span: it cannot explain anything; drop the effect or train on a span where it changes");
-      input_col_.push_back(col);
-      if (e.kind == EffectKind::Expansion) {
+      if (e.kind == EffectKind::Expansion) {  // known: a fixed prediction, not a regressor
         const auto r = c.atErrorTimes(regressor(e, c.inputs.t_s, u, 0));
         fixed_ += Eigen::Map<const Eigen::VectorXd>(r.data(), N);
-        input_col_.pop_back();
         continue;
       }
       columns_.push_back(&e);
+      col_input_.push_back(col);
       if (e.hasTimeConstant()) nonlinear_.push_back(static_cast<int>(columns_.size()) - 1);
     }
-    // Column index -> input column (drift has none).
-    col_input_.clear();
-    for (const Effect* e : columns_) col_input_.push_back(e->kind == EffectKind::Drift ? -1 : c.inputs.column(e->input));
   }
 
   int linearCount() const { return 1 + static_cast<int>(columns_.size()); }
@@ -130,13 +127,12 @@ class ChannelRegression {
 
  private:
   const Campaign& c_;
-  const std::vector<Effect>& effects_;
   int n_;
   int ch_ = -1;
   std::string name_;
   Eigen::VectorXd y_, fixed_;
   std::vector<const Effect*> columns_;
-  std::vector<int> input_col_, col_input_, nonlinear_;
+  std::vector<int> col_input_, nonlinear_;  // per column: its inputs.csv column (-1: drift); the lag/transient columns
 };
 
 struct VarProResidual {
@@ -284,6 +280,8 @@ ChannelFit fitChannel(const Campaign& c, const std::string& channel, const std::
   const Eigen::MatrixXd Vinv = svd.matrixV() * sv.cwiseInverse().cwiseAbs2().asDiagonal() * svd.matrixV().transpose();
   const Eigen::MatrixXd cov = s2 * scale.cwiseInverse().asDiagonal() * Vinv * scale.cwiseInverse().asDiagonal();
   fit.sigma = std::sqrt(s2);
+  // Rissanen's MDL, V_N (1 + p ln n / n): seed 004 Eq. 4.23 penalised by the parameter count
+  // (the printed form does not penalise order; docs/decisions.md).
   fit.mdl = res.squaredNorm() / n * (1 + p * std::log(static_cast<double>(n)) / n);
 
   // Parameters in the field's units.

@@ -18,26 +18,16 @@
 #include "evaluate/sphere_campaign.hpp"
 #include "planner/sphere_cycle.hpp"
 #include "sim/virtual_machine.hpp"
+#include "sim/test_support.hpp"
 
 namespace probeloop::sim {
 namespace {
+using test::src;
+using test::tempDir;
+using test::truthFrom;
+using test::writeTemp;
 
 namespace fs = std::filesystem;
-
-std::string src(const std::string& rel) { return std::string(PROBELOOP_SOURCE_DIR) + "/" + rel; }
-
-std::string writeTemp(const std::string& name, const std::string& text) {
-  static std::atomic<int> n{0};
-  const fs::path d = fs::temp_directory_path() /
-                     ("probeloop-tc-" + std::to_string(::getpid()) + "-" + std::to_string(n++));
-  fs::create_directories(d);
-  std::ofstream(d / name) << text;
-  return (d / name).string();
-}
-
-MachineTruth truthFrom(const std::string& yaml) {
-  return loadMachineTruth(writeTemp("truth.yaml", "kind: machine_truth\n" + yaml));
-}
 
 struct Run {
   parts::PlanManifest manifest;

@@ -2,6 +2,7 @@
 // time, the evaluator reads what the controller reported, and the result is compared with
 // the effect's analytic signature (derived here, not taken from the simulator).
 #include "sim/virtual_machine.hpp"
+#include "sim/test_support.hpp"
 
 #include <gtest/gtest.h>
 
@@ -21,29 +22,13 @@
 
 namespace probeloop::sim {
 namespace {
+using test::src;
+using test::tempDir;
+using test::truthFrom;
+using test::writeTemp;
 
 namespace fs = std::filesystem;
 using Eigen::Vector3d;
-
-std::string src(const std::string& rel) { return std::string(PROBELOOP_SOURCE_DIR) + "/" + rel; }
-
-fs::path tempDir() {
-  static std::atomic<int> n{0};
-  const fs::path d = fs::temp_directory_path() /
-                     ("probeloop-vm-" + std::to_string(::getpid()) + "-" + std::to_string(n++));
-  fs::create_directories(d);
-  return d;
-}
-
-std::string writeTemp(const std::string& name, const std::string& text) {
-  const fs::path p = tempDir() / name;
-  std::ofstream(p) << text;
-  return p.string();
-}
-
-MachineTruth truthFrom(const std::string& yaml) {
-  return loadMachineTruth(writeTemp("truth.yaml", "kind: machine_truth\n" + yaml));
-}
 
 struct Campaign {
   parts::PlanManifest manifest;
