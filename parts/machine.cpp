@@ -38,6 +38,11 @@ RotaryAxis readRotary(YamlMap m, bool with_sense) {
   }
   a.max_speed_rpm = m.quantity("max_speed", Dimension::RotSpeed);
   if (!(a.max_speed_rpm > 0)) m.fail("max_speed", "must be positive");
+  a.max_turning_speed_rpm = m.quantityOr("max_turning_speed", Dimension::RotSpeed, a.max_speed_rpm);
+  if (!(a.max_turning_speed_rpm >= a.max_speed_rpm))
+    m.fail("max_turning_speed", "the turning mode is at least as fast as positioning (max_speed)");
+  if (a.max_turning_speed_rpm != a.max_speed_rpm && !a.continuous)
+    m.fail("max_turning_speed", "a turning mode needs a continuous axis (continuous: true)");
   a.resolution_deg = m.quantity("resolution", Dimension::Angle);
   if (with_sense) {
     a.positive_is_clockwise =

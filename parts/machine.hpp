@@ -24,7 +24,10 @@ struct RotaryAxis {
   bool present = false;
   bool continuous = false;              // no travel limit
   double min_deg = 0, max_deg = 0;
-  double max_speed_rpm = 0;
+  double max_speed_rpm = 0;          // positioning (G0, indexing)
+  // Continuous turning in a feed move of this axis alone (a table in turning mode, seed 004
+  // L2024: C at 1200 rpm); default max_speed.
+  double max_turning_speed_rpm = 0;
   double resolution_deg = 0.001;
   // Sense in which the table turns for +C, seen from +Z. A workpiece-side C' axis turns the
   // table clockwise for +C (ISO 841: the workpiece moves opposite to the tool's +C).

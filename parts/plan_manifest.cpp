@@ -17,6 +17,24 @@ const ManifestSphere* PlanManifest::sphere(int position) const {
   return nullptr;
 }
 
+const ManifestFeature* PlanManifest::feature(const std::string& id) const {
+  for (const auto& f : features)
+    if (f.nominal.id == id) return &f;
+  return nullptr;
+}
+
+const ManifestFeature* PlanManifest::featureAtPosition(int position) const {
+  for (const auto& f : features)
+    if (f.position == position && position > 0) return &f;
+  return nullptr;
+}
+
+const ManifestProgram* PlanManifest::program(const std::string& role) const {
+  for (const auto& p : programs)
+    if (p.role == role) return &p;
+  return nullptr;
+}
+
 int PlanManifest::pointsPerSphere() const {
   if (spheres.empty()) return 0;
   return static_cast<int>(points.size() / spheres.size());
@@ -44,7 +62,99 @@ double optional(const ordered_json& j, const char* key) {
 }
 }  // namespace
 
+namespace {
+
+ordered_json machineJson(const PlanManifest& m) {
+  return {{"name", m.machine_name},
+                  {"c_axis_centre_mm", {m.c_axis_centre_mm.x(), m.c_axis_centre_mm.y()}},
+                  {"c_positive_is_clockwise", m.c_positive_is_clockwise},
+                  {"table_surface_z_mm", m.table_surface_z_mm},
+                  {"coordinate_resolution_mm", m.coordinate_resolution_mm}};
+}
+
+ordered_json probeJson(const PlanManifest& m) {
+  return {{"tool", m.probe_tool},
+          {"tip_radius_mm", m.tip_radius_mm},
+          {"repeatability_2sigma_um", m.probe_repeatability_2sigma_um},
+          {"tool_change_repeatability_2sigma_um", orNull(m.probe_tool_change_repeatability_2sigma_um)}};
+}
+
+ordered_json scheduleJson(const PlanManifest& m) {
+  return {{"cycles", m.cycles},
+          {"gap_s", m.gap_s},
+          {"tool_change_each_cycle", m.tool_change_each_cycle},
+          {"cycle_time_s", m.cycle_time_s},
+          {"cycle_start_s", m.cycle_start_s}};
+}
+
+// Kinds other than the sphere artifact: features, cycles, cuts and points of any geometry.
+std::string genericManifestJson(const PlanManifest& m) {
+  ordered_json j;
+  j["format"] = "probeloop-plan-manifest";
+  j["version"] = 1;
+  j["kind"] = m.kind;
+  j["dialect"] = m.dialect;
+  for (const auto& p : m.programs)
+    j["programs"].push_back({{"file", p.file}, {"dialect", p.dialect}, {"log_file", p.log_file}, {"role", p.role},
+                             {"start_s", p.start_s}, {"duration_s", p.duration_s}});
+  j["machine"] = machineJson(m);
+  j["probe"] = probeJson(m);
+  j["part"] = {{"name", m.part_name},
+               {"origin_mm", vec(m.part_origin_mm)},
+               {"material", m.material_name},
+               {"alpha_um_per_m_K", orNull(m.material_alpha_um_per_m_K)}};
+  if (m.kind == "thermal_test_piece") {
+    const auto& t = m.ttp;
+    j["thermal_test_piece"] = {{"z_paths", t.z_paths},
+                               {"facets_per_segment", t.facets_per_segment},
+                               {"facet_apothem_mm", t.facet_apothem_mm},
+                               {"test_tool_radius_mm", t.test_tool_radius_mm},
+                               {"eq_7_10", {{"alpha_um_per_m_K", t.eq_7_10_alpha_um_per_m_K},
+                                            {"alpha_u_um_per_m_K", t.alpha_u_um_per_m_K},
+                                            {"radius_mm", t.eq_7_10_radius_mm}}},
+                               {"cmm", {{"mpe_constant_um", t.cmm.mpe_constant_um},
+                                        {"mpe_length_mm", t.cmm.mpe_length_mm},
+                                        {"temperature_half_width_K", t.cmm.temperature_half_width_K}}},
+                               {"on_machine", {{"repeatability_um", t.on_machine_repeatability_um},
+                                               {"temperature_change_K", t.on_machine_temperature_change_K}}},
+                               {"cmm_plan", t.cmm_plan}};
+  }
+  j["features"] = ordered_json::array();
+  for (const auto& f : m.features) {
+    const auto& n = f.nominal;
+    j["features"].push_back({{"id", n.id}, {"kind", n.kind}, {"role", n.role}, {"group", n.group}, {"index", n.index},
+                             {"point_mm", vec(n.point_mm)}, {"direction", vec(n.direction)}, {"u", vec(n.u)},
+                             {"half_u_mm", n.half_u_mm}, {"half_v_mm", n.half_v_mm}, {"radius_mm", n.radius_mm},
+                             {"angle_deg", n.angle_deg}, {"cycle", f.cycle}, {"cut_time_s", orNull(f.cut_time_s)},
+                             {"position", f.position}, {"probe_c_deg", orNull(f.probe_c_deg)}});
+  }
+  j["cycles"] = ordered_json::array();
+  for (const auto& c : m.cut_cycles)
+    j["cycles"].push_back({{"cycle", c.cycle}, {"phase", c.phase}, {"c_axis_rpm_before", c.c_axis_rpm_before},
+                           {"start_s", c.start_s}, {"end_s", c.end_s}, {"z_path", c.z_path}, {"facet", c.facet},
+                           {"c_x_deg", c.c_x_deg}, {"c_y_deg", c.c_y_deg}});
+  j["cuts"] = ordered_json::array();
+  for (const auto& c : m.cuts)
+    j["cuts"].push_back({{"id", c.id}, {"program", c.program}, {"feature", c.feature}, {"cycle", c.cycle}, {"tool", c.tool},
+                         {"c_deg", c.c_deg}, {"start_s", c.start_s}, {"end_s", c.end_s}, {"from_mm", vec(c.from_mm)},
+                         {"to_mm", vec(c.to_mm)}});
+  j["points"] = ordered_json::array();
+  for (const auto& p : m.points)
+    j["points"].push_back({{"feature", p.feature}, {"position", p.position}, {"point", p.point},
+                           {"contact_mm", vec(p.contact_mm)}, {"approach", vec(p.approach)},
+                           {"tip_radius_mm", m.tip_radius_mm}, {"c_deg", p.c_deg},
+                           {"time_in_cycle_s", p.time_in_cycle_s}});
+  j["evaluation"] = ordered_json::array();
+  for (const auto& e : m.evaluation)
+    j["evaluation"].push_back({{"output", e.output}, {"formula", e.formula}, {"source", e.source}, {"features", e.features}});
+  j["schedule"] = scheduleJson(m);
+  return j.dump(1) + "\n";
+}
+
+}  // namespace
+
 std::string manifestToJson(const PlanManifest& m) {
+  if (m.kind != "sphere_artifact") return genericManifestJson(m);
   ordered_json j;
   j["format"] = "probeloop-plan-manifest";
   j["version"] = 1;
@@ -52,15 +162,8 @@ std::string manifestToJson(const PlanManifest& m) {
   j["dialect"] = m.dialect;
   for (const auto& p : m.programs)
     j["programs"].push_back({{"file", p.file}, {"dialect", p.dialect}, {"log_file", p.log_file}});
-  j["machine"] = {{"name", m.machine_name},
-                  {"c_axis_centre_mm", {m.c_axis_centre_mm.x(), m.c_axis_centre_mm.y()}},
-                  {"c_positive_is_clockwise", m.c_positive_is_clockwise},
-                  {"table_surface_z_mm", m.table_surface_z_mm},
-                  {"coordinate_resolution_mm", m.coordinate_resolution_mm}};
-  j["probe"] = {{"tool", m.probe_tool},
-                {"tip_radius_mm", m.tip_radius_mm},
-                {"repeatability_2sigma_um", m.probe_repeatability_2sigma_um},
-                {"tool_change_repeatability_2sigma_um", orNull(m.probe_tool_change_repeatability_2sigma_um)}};
+  j["machine"] = machineJson(m);
+  j["probe"] = probeJson(m);
   j["artifact"] = {{"sphere_radius_mm", m.sphere_radius_mm},
                    {"sphere_form_error_um", m.sphere_form_error_um},
                    {"radius_from_axis_mm", m.radius_from_axis_mm},
@@ -88,13 +191,118 @@ std::string manifestToJson(const PlanManifest& m) {
                            {"tip_radius_mm", m.tip_radius_mm},
                            {"time_in_cycle_s", p.time_in_cycle_s}});
   }
-  j["schedule"] = {{"cycles", m.cycles},
-                   {"gap_s", m.gap_s},
-                   {"tool_change_each_cycle", m.tool_change_each_cycle},
-                   {"cycle_time_s", m.cycle_time_s},
-                   {"cycle_start_s", m.cycle_start_s}};
+  j["schedule"] = scheduleJson(m);
   return j.dump(1) + "\n";
 }
+
+namespace {
+
+void readSchedule(const ordered_json& s, PlanManifest& m) {
+  m.cycles = s.at("cycles");
+  m.tool_change_each_cycle = s.value("tool_change_each_cycle", false);
+  m.gap_s = s.at("gap_s");
+  m.cycle_time_s = s.at("cycle_time_s");
+  m.cycle_start_s = s.at("cycle_start_s").get<std::vector<double>>();
+  if (static_cast<int>(m.cycle_start_s.size()) != m.cycles)
+    throw InputError(m.file, 0, "schedule.cycle_start_s does not have one entry per cycle");
+}
+
+// Kinds other than the sphere artifact (the caller catches json exceptions).
+void readGeneric(const ordered_json& j, PlanManifest& m) {
+  const std::string& path = m.file;
+  const auto& part = j.at("part");
+  m.part_name = part.at("name");
+  m.part_origin_mm = readVec(part.at("origin_mm"), path, "part.origin_mm");
+  m.material_name = part.at("material");
+  m.material_alpha_um_per_m_K = optional(part, "alpha_um_per_m_K");
+  if (m.kind == "thermal_test_piece") {
+    const auto& t = j.at("thermal_test_piece");
+    auto& c = m.ttp;
+    c.z_paths = t.at("z_paths");
+    c.facets_per_segment = t.at("facets_per_segment");
+    c.facet_apothem_mm = t.at("facet_apothem_mm");
+    c.test_tool_radius_mm = t.at("test_tool_radius_mm");
+    c.eq_7_10_alpha_um_per_m_K = t.at("eq_7_10").at("alpha_um_per_m_K");
+    c.alpha_u_um_per_m_K = t.at("eq_7_10").at("alpha_u_um_per_m_K");
+    c.eq_7_10_radius_mm = t.at("eq_7_10").at("radius_mm");
+    c.cmm.mpe_constant_um = t.at("cmm").at("mpe_constant_um");
+    c.cmm.mpe_length_mm = t.at("cmm").at("mpe_length_mm");
+    c.cmm.temperature_half_width_K = t.at("cmm").at("temperature_half_width_K");
+    c.on_machine_repeatability_um = t.at("on_machine").at("repeatability_um");
+    c.on_machine_temperature_change_K = t.at("on_machine").at("temperature_change_K");
+    c.cmm_plan = t.at("cmm_plan");
+  }
+  for (const auto& f : j.at("features")) {
+    ManifestFeature x;
+    auto& n = x.nominal;
+    n.id = f.at("id");
+    n.kind = f.at("kind");
+    n.role = f.at("role");
+    n.group = f.at("group");
+    n.index = f.at("index");
+    n.point_mm = readVec(f.at("point_mm"), path, "features[].point_mm");
+    n.direction = readVec(f.at("direction"), path, "features[].direction");
+    n.u = readVec(f.at("u"), path, "features[].u");
+    n.half_u_mm = f.at("half_u_mm");
+    n.half_v_mm = f.at("half_v_mm");
+    n.radius_mm = f.at("radius_mm");
+    n.angle_deg = f.at("angle_deg");
+    x.cycle = f.at("cycle");
+    x.cut_time_s = optional(f, "cut_time_s");
+    x.position = f.at("position");
+    x.probe_c_deg = optional(f, "probe_c_deg");
+    if (m.feature(n.id)) throw InputError(path, 0, "feature " + n.id + " is listed twice");
+    m.features.push_back(x);
+  }
+  for (const auto& c : j.at("cycles")) {
+    ManifestCycle x;
+    x.cycle = c.at("cycle");
+    x.phase = c.at("phase");
+    x.c_axis_rpm_before = c.at("c_axis_rpm_before");
+    x.start_s = c.at("start_s");
+    x.end_s = c.at("end_s");
+    x.z_path = c.at("z_path");
+    x.facet = c.at("facet");
+    x.c_x_deg = c.at("c_x_deg");
+    x.c_y_deg = c.at("c_y_deg");
+    m.cut_cycles.push_back(x);
+  }
+  for (const auto& c : j.at("cuts")) {
+    ManifestCut x;
+    x.id = c.at("id");
+    x.program = c.at("program");
+    x.feature = c.at("feature");
+    x.cycle = c.at("cycle");
+    x.tool = c.at("tool");
+    x.c_deg = c.at("c_deg");
+    x.start_s = c.at("start_s");
+    x.end_s = c.at("end_s");
+    x.from_mm = readVec(c.at("from_mm"), path, "cuts[].from_mm");
+    x.to_mm = readVec(c.at("to_mm"), path, "cuts[].to_mm");
+    m.cuts.push_back(x);
+  }
+  for (const auto& p : j.at("points")) {
+    ManifestPoint q;
+    q.feature = p.at("feature");
+    q.position = p.at("position");
+    q.point = p.at("point");
+    q.contact_mm = readVec(p.at("contact_mm"), path, "points[].contact_mm");
+    q.approach = readVec(p.at("approach"), path, "points[].approach");
+    q.c_deg = p.at("c_deg");
+    q.time_in_cycle_s = p.at("time_in_cycle_s");
+    const auto* f = m.feature(q.feature);
+    if (!f) throw InputError(path, 0, "a point names the feature " + q.feature + ", which the manifest does not list");
+    if (f->position != q.position)
+      throw InputError(path, 0, "a point of feature " + q.feature + " has position " + std::to_string(q.position) +
+                                    ", the feature " + std::to_string(f->position));
+    m.points.push_back(q);
+  }
+  for (const auto& e : j.at("evaluation"))
+    m.evaluation.push_back({e.at("output"), e.at("formula"), e.at("source"), e.at("features")});
+  readSchedule(j.at("schedule"), m);
+}
+
+}  // namespace
 
 PlanManifest readManifest(const std::string& path) {
   ordered_json j;
@@ -112,9 +320,16 @@ PlanManifest readManifest(const std::string& path) {
       throw InputError(path, 0, "manifest version " + j.at("version").dump() + " is not supported");
     m.kind = j.at("kind").get<std::string>();
     m.dialect = j.at("dialect").get<std::string>();
-    for (const auto& p : j.at("programs"))
-      m.programs.push_back({p.at("file").get<std::string>(), p.at("dialect").get<std::string>(),
-                            p.at("log_file").get<std::string>()});
+    for (const auto& p : j.at("programs")) {
+      ManifestProgram q;
+      q.file = p.at("file").get<std::string>();
+      q.dialect = p.at("dialect").get<std::string>();
+      q.log_file = p.at("log_file").get<std::string>();
+      q.role = p.value("role", "");
+      q.start_s = p.value("start_s", 0.0);
+      q.duration_s = p.value("duration_s", 0.0);
+      m.programs.push_back(q);
+    }
     const auto& mc = j.at("machine");
     m.machine_name = mc.at("name");
     m.c_axis_centre_mm = Eigen::Vector2d(mc.at("c_axis_centre_mm").at(0).get<double>(),
@@ -127,6 +342,10 @@ PlanManifest readManifest(const std::string& path) {
     m.tip_radius_mm = pr.at("tip_radius_mm");
     m.probe_repeatability_2sigma_um = pr.at("repeatability_2sigma_um");
     m.probe_tool_change_repeatability_2sigma_um = optional(pr, "tool_change_repeatability_2sigma_um");
+    if (m.kind != "sphere_artifact") {
+      readGeneric(j, m);
+      return m;
+    }
     const auto& a = j.at("artifact");
     m.sphere_radius_mm = a.at("sphere_radius_mm");
     m.sphere_form_error_um = a.at("sphere_form_error_um");
@@ -156,20 +375,13 @@ PlanManifest readManifest(const std::string& path) {
       q.time_in_cycle_s = p.at("time_in_cycle_s");
       m.points.push_back(q);
     }
-    const auto& s = j.at("schedule");
-    m.cycles = s.at("cycles");
-    m.tool_change_each_cycle = s.value("tool_change_each_cycle", false);
-    m.gap_s = s.at("gap_s");
-    m.cycle_time_s = s.at("cycle_time_s");
-    m.cycle_start_s = s.at("cycle_start_s").get<std::vector<double>>();
+    readSchedule(j.at("schedule"), m);
   } catch (const ordered_json::exception& e) {
     throw InputError(path, 0, std::string("manifest field missing or of the wrong type: ") + e.what());
   }
   if (m.spheres.size() < 3) throw InputError(path, 0, "manifest has fewer than 3 sphere positions");
   if (m.points.size() % m.spheres.size() != 0)
     throw InputError(path, 0, "manifest points are not the same number per sphere");
-  if (static_cast<int>(m.cycle_start_s.size()) != m.cycles)
-    throw InputError(path, 0, "schedule.cycle_start_s does not have one entry per cycle");
   for (const auto& p : m.points)
     if (!m.sphere(p.position))
       throw InputError(path, 0, "point of feature " + p.feature + " names a missing position");

@@ -3,13 +3,21 @@
 // by `evaluate` and the simulators. Schema: docs/formats.md#plan-manifest.
 #pragma once
 #include <Eigen/Dense>
+#include <cmath>
 #include <string>
 #include <vector>
+
+#include "parts/feature.hpp"
+#include "parts/workpiece.hpp"
 
 namespace probeloop::parts {
 
 struct ManifestProgram {
   std::string file, dialect, log_file;
+  // Kinds with several programs: pre_machining | test | inspection, and when each starts on
+  // the planned clock (back to back from the first program's start) and how long it runs.
+  std::string role;
+  double start_s = 0, duration_s = 0;
 };
 
 // One sphere measurement = one C position of the cycle.
@@ -29,6 +37,48 @@ struct ManifestPoint {
   Eigen::Vector3d contact_mm = Eigen::Vector3d::Zero();  // nominal tip centre at contact
   Eigen::Vector3d approach = Eigen::Vector3d::Zero();    // unit direction of travel
   double time_in_cycle_s = 0;                            // planned trigger time
+  double c_deg = 0;  // kinds other than the sphere artifact: C while this point is probed
+};
+
+// Kinds other than the sphere artifact: a nominal feature with what the plan adds to it.
+struct ManifestFeature {
+  NominalFeature nominal;    // part frame
+  int cycle = -1;            // cutting cycle that finishes it (0 = reference); -1 = pre-machining
+  double cut_time_s = NAN;   // planned mid-time of the cut that finishes it (planned clock)
+  int position = 0;          // on-machine inspection: the log's position number; 0 = not probed
+  double probe_c_deg = NAN;  // C while it is probed on the machine
+};
+
+// One cutting cycle of a test (seed 004 Fig. 7.4): the surfaces it finishes and its C indices.
+struct ManifestCycle {
+  int cycle = 0;
+  std::string phase;             // reference | warm_up | hold
+  double c_axis_rpm_before = 0;  // the table's speed during the wait before it
+  double start_s = 0, end_s = 0;
+  int z_path = 0, facet = 0;
+  double c_x_deg = 0, c_y_deg = 0;  // C while the X and the Y facets are cut
+};
+
+// One cutting move that finishes a feature (or a pre-machining operation).
+struct ManifestCut {
+  std::string id, program, feature;  // feature "" = no measured feature (roughing, notches ...)
+  int cycle = -1;
+  int tool = 0;
+  double c_deg = 0;
+  double start_s = 0, end_s = 0;                        // planned clock
+  Eigen::Vector3d from_mm = Eigen::Vector3d::Zero();    // tool tip, program = machine coordinates
+  Eigen::Vector3d to_mm = Eigen::Vector3d::Zero();
+};
+
+// What the thermal-test-piece evaluation needs beyond the features (seed 004 Ch. 7).
+struct ThermalTestPieceConstants {
+  int z_paths = 0, facets_per_segment = 0;
+  double facet_apothem_mm = 0;
+  double test_tool_radius_mm = 0;
+  double eq_7_10_alpha_um_per_m_K = 0, alpha_u_um_per_m_K = 0, eq_7_10_radius_mm = 0;
+  CmmSpec cmm;
+  double on_machine_repeatability_um = 0, on_machine_temperature_change_K = 0;
+  std::string cmm_plan;  // the CMM point plan written beside the manifest
 };
 
 struct PlanManifest {
@@ -63,8 +113,21 @@ struct PlanManifest {
   double gap_s = 0;
   double cycle_time_s = 0;
   std::vector<double> cycle_start_s;
+  // Kinds other than the sphere artifact (empty for it).
+  std::string part_name;
+  Eigen::Vector3d part_origin_mm = Eigen::Vector3d::Zero();  // part frame origin, machine coords at C = 0
+  std::string material_name;
+  double material_alpha_um_per_m_K = NAN;
+  std::vector<ManifestFeature> features;
+  std::vector<ManifestCycle> cut_cycles;
+  std::vector<ManifestCut> cuts;
+  std::vector<EvaluationRule> evaluation;
+  ThermalTestPieceConstants ttp;
 
   const ManifestSphere* sphere(int position) const;
+  const ManifestFeature* feature(const std::string& id) const;  // nullptr if absent
+  const ManifestFeature* featureAtPosition(int position) const;
+  const ManifestProgram* program(const std::string& role) const;
   int pointsPerSphere() const;
 };
 

@@ -14,7 +14,7 @@ const CuttingTool* Workpiece::tool(int number) const {
 std::string partKind(const std::string& path) {
   const YAML::Node n = loadYamlFile(path);
   if (!n.IsMap() || !n["kind"] || !n["kind"].IsScalar())
-    throw InputError(path, 1, "kind: expected the kind of part (sphere_artifact or workpiece)");
+    throw InputError(path, 1, "kind: expected the kind of part (sphere_artifact, thermal_test_piece or workpiece)");
   return n["kind"].Scalar();
 }
 
@@ -28,31 +28,27 @@ std::pair<double, double> range(YamlMap& m, const std::string& key) {
 
 }  // namespace
 
-Workpiece loadWorkpiece(const std::string& path) {
-  YamlMap root(loadYamlFile(path), path, "");
-  root.choice("kind", {"workpiece"});
-  Workpiece w;
-  w.file = path;
-  w.name = root.stringOr("name", "workpiece");
-  YamlMap s = root.map("stock");
-  const auto x = range(s, "x"), y = range(s, "y"), z = range(s, "z");
-  w.stock_min_mm = Eigen::Vector3d(x.first, y.first, z.first);
-  w.stock_max_mm = Eigen::Vector3d(x.second, y.second, z.second);
-  s.finish();
-
-  YamlMap m = root.map("material");
-  w.material.name = m.string("name");
-  w.material.alpha_per_K = m.number("alpha_um_per_m_K") * 1e-6;
-  w.material.specific_cutting_force_N_per_mm2 = m.number("specific_cutting_force_N_per_mm2");
-  w.material.radial_force_ratio = m.numberOr("radial_force_ratio", 0.4);
-  if (!(w.material.specific_cutting_force_N_per_mm2 > 0)) m.fail("specific_cutting_force_N_per_mm2", "must be positive");
-  if (w.material.radial_force_ratio < 0) m.fail("radial_force_ratio", "must not be negative");
+WorkpieceMaterial readMaterial(YamlMap m) {
+  WorkpieceMaterial out;
+  out.name = m.string("name");
+  out.alpha_per_K = m.number("alpha_um_per_m_K") * 1e-6;
+  out.specific_cutting_force_N_per_mm2 = m.number("specific_cutting_force_N_per_mm2");
+  out.radial_force_ratio = m.numberOr("radial_force_ratio", 0.4);
+  if (!(out.alpha_per_K >= 0 && out.alpha_per_K < 1e-4))
+    m.fail("alpha_um_per_m_K", "expected an expansion coefficient in um/(m K), e.g. 23.4 for aluminium");
+  if (!(out.specific_cutting_force_N_per_mm2 > 0)) m.fail("specific_cutting_force_N_per_mm2", "must be positive");
+  if (out.radial_force_ratio < 0) m.fail("radial_force_ratio", "must not be negative");
   m.finish();
+  return out;
+}
 
-  for (auto& t : root.mapList("tools")) {
+std::vector<CuttingTool> readCuttingTools(YamlMap& parent, const std::string& key) {
+  std::vector<CuttingTool> out;
+  for (auto& t : parent.mapList(key)) {
     CuttingTool c;
     c.number = t.integer("number");
-    t.choice("kind", {"flat_end_mill"});
+    c.kind = t.choice("kind", {"flat_end_mill", "engraving"});
+    c.name = t.stringOr("name", "");
     c.diameter_mm = t.quantity("diameter", Dimension::Length);
     c.length_mm = t.quantity("length", Dimension::Length);
     c.stickout_mm = t.quantity("stickout", Dimension::Length);
@@ -65,16 +61,40 @@ Workpiece loadWorkpiece(const std::string& path) {
     if (!(c.flute_length_mm > 0 && c.flute_length_mm <= c.stickout_mm))
       t.fail("flute_length", "must be positive and at most the stickout");
     if (!(c.youngs_modulus_N_per_mm2 > 0)) t.fail("youngs_modulus_GPa", "must be positive");
-    if (w.tool(c.number)) t.fail("number", "tool T" + std::to_string(c.number) + " is listed twice");
+    for (const auto& e : out)
+      if (e.number == c.number) t.fail("number", "tool T" + std::to_string(c.number) + " is listed twice");
     t.finish();
-    w.tools.push_back(c);
+    out.push_back(c);
   }
-  if (auto c = root.mapIfPresent("cmm")) {
-    w.cmm.mpe_constant_um = c->quantity("mpe_constant", Dimension::Micrometre);
-    w.cmm.mpe_length_mm = c->quantityOr("mpe_length", Dimension::Length, 0);
-    if (w.cmm.mpe_constant_um < 0) c->fail("mpe_constant", "must not be negative");
-    c->finish();
-  }
+  return out;
+}
+
+CmmSpec readCmm(YamlMap c) {
+  CmmSpec out;
+  out.mpe_constant_um = c.quantity("mpe_constant", Dimension::Micrometre);
+  out.mpe_length_mm = c.quantityOr("mpe_length", Dimension::Length, 0);
+  out.temperature_half_width_K = c.quantityOr("temperature_half_width", Dimension::Temperature, 0);
+  if (out.mpe_constant_um < 0) c.fail("mpe_constant", "must not be negative");
+  if (out.mpe_length_mm < 0) c.fail("mpe_length", "must not be negative");
+  if (out.temperature_half_width_K < 0) c.fail("temperature_half_width", "must not be negative");
+  c.finish();
+  return out;
+}
+
+Workpiece loadWorkpiece(const std::string& path) {
+  YamlMap root(loadYamlFile(path), path, "");
+  root.choice("kind", {"workpiece"});
+  Workpiece w;
+  w.file = path;
+  w.name = root.stringOr("name", "workpiece");
+  YamlMap s = root.map("stock");
+  const auto x = range(s, "x"), y = range(s, "y"), z = range(s, "z");
+  w.stock_min_mm = Eigen::Vector3d(x.first, y.first, z.first);
+  w.stock_max_mm = Eigen::Vector3d(x.second, y.second, z.second);
+  s.finish();
+  w.material = readMaterial(root.map("material"));
+  w.tools = readCuttingTools(root, "tools");
+  if (auto c = root.mapIfPresent("cmm")) w.cmm = readCmm(*c);
   root.finish();
   return w;
 }
