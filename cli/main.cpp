@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "cli/model_commands.hpp"
+#include "cli/report_commands.hpp"
 #include "core/atomic_file.hpp"
 #include "core/csv.hpp"
 #include "core/error.hpp"
@@ -16,13 +17,17 @@
 #include "evaluate/ingest.hpp"
 #include "evaluate/point_cloud.hpp"
 #include "evaluate/sphere_campaign.hpp"
+#include "evaluate/test_piece.hpp"
 #include "parts/gum_model.hpp"
 #include "parts/machine.hpp"
 #include "parts/plan_manifest.hpp"
 #include "parts/sphere_artifact.hpp"
 #include "parts/workpiece.hpp"
+#include "parts/test_piece.hpp"
 #include "planner/sphere_cycle.hpp"
+#include "planner/test_piece.hpp"
 #include "report/scene.hpp"
+#include "report/ttp_scene.hpp"
 #include "sim/rigid_campaign.hpp"
 #include "sim/virtual_machine.hpp"
 
@@ -35,66 +40,29 @@ std::string join(const std::string& dir, const std::string& file) {
   return (fs::path(dir) / file).string();
 }
 
-void printResolution(const evaluate::Resolution& r, double step_um) {
-  std::printf("Resolution of the location errors for a %s um coordinate step (seed 004 Table 5.4):\n",
-              formatNumber(step_um).c_str());
-  std::printf("  %-10s %16s %16s\n", "error", "Eqs. 5.4-5.10", "least squares");
-  for (int j = 0; j < 7; ++j) {
-    std::string n = geometry::LocationErrors::names()[j];
-    const std::string unit = j < 4 ? "um" : "um/m";
-    n = n.substr(0, n.find('_'));
-    const std::string f = r.formulas ? formatNumber((*r.formulas)[j], 4) + " " + unit : "n/a";
-    std::printf("  %-10s %16s %16s\n", n.c_str(), f.c_str(),
-                (formatNumber(r.least_squares[j], 4) + " " + unit).c_str());
-  }
-}
-
-void printPrediction(const parts::PlanManifest& m) {
-  const auto b = evaluate::predictLocationErrorBudgets(m);
-  std::printf("Predicted expanded uncertainty (k = 2) of each error of a cycle, before measuring\n"
-              "(d/2 = %s mm, %d points per sphere; drift and the d/2 term depend on measured values):\n",
-              formatNumber(m.radius_from_axis_mm).c_str(), m.pointsPerSphere());
-  for (const auto& x : b)
-    std::printf("  %-6s U = %7s %-4s  largest: %s\n", x.quantity.c_str(), formatNumber(x.U, 3).c_str(), x.unit.c_str(),
-                x.contributions.empty() ? "" : x.contributions.front().input.c_str());
-}
-
-int cmdPlan(const std::string& artifact_file, const std::string& machine_file,
-            const std::string& out_dir, const std::string& dialect_opt) {
-  const auto artifact = parts::loadSphereArtifact(artifact_file);
+int cmdPlan(const std::string& piece_file, const std::string& machine_file, const std::string& out_dir,
+            const std::string& dialect_opt) {
+  const auto piece = parts::loadTestPiece(piece_file);
   const auto machine = parts::loadMachine(machine_file);
-  planner::PlanFiles files;
   const bool linux = dialect_opt == "linuxcnc" || (dialect_opt == "machine" && machine.dialect == parts::Dialect::LinuxCnc);
-  files.program_file = linux ? "sphere_cycle.ngc" : "sphere_cycle.nc";
-  auto plan = planner::planSphereCycle(artifact, machine, files);
-  const auto dialect = linux ? parts::Dialect::LinuxCnc : parts::Dialect::FanucMacroB;
-  plan.manifest.dialect = parts::dialectName(dialect);
-  plan.manifest.programs.front().dialect = plan.manifest.dialect;
-  const std::string program = planner::programText(plan, dialect);
-  writeFileAtomic(join(out_dir, files.program_file), program);
+  const auto plan = planner::planTestPiece(piece, machine, linux ? parts::Dialect::LinuxCnc : parts::Dialect::FanucMacroB,
+                                           out_dir);
+  // Everything is planned and checked before the first file is written.
+  for (const auto& p : plan.programs) writeFileAtomic(join(out_dir, p.file), p.text);
+  for (const auto& [name, content] : plan.files) writeFileAtomic(join(out_dir, name), content);
   writeFileAtomic(join(out_dir, "plan.json"), parts::manifestToJson(plan.manifest));
-
-  const auto& t = plan.cycle_time;
-  std::printf("Planned %d cycles of the sphere cycle for %s (%s dialect)\n", plan.manifest.cycles,
-              machine.name.c_str(), parts::dialectName(dialect));
-  std::printf("  wrote %s and %s\n", join(out_dir, files.program_file).c_str(),
-              join(out_dir, "plan.json").c_str());
-  std::printf("Estimated cycle time %.1f s (seed 004: 95 s incl. two tool changes):\n", t.total());
-  std::printf("  tool changes %6.1f s\n  C indexing   %6.1f s\n  rapids       %6.1f s\n"
-              "  protected    %6.1f s\n  probing      %6.1f s\n",
-              t.tool_change_s, t.c_index_s, t.rapid_s, t.protected_s, t.probing_s);
-  std::printf("  (no acceleration; see docs/sphere-cycle.md for the comparison with 95 s)\n");
-  printResolution(evaluate::locationErrorResolution(plan.manifest, machine.x.resolution_mm),
-                  machine.x.resolution_mm * 1e3);
-  printPrediction(plan.manifest);
+  std::fputs(plan.summary.c_str(), stdout);
+  std::fputs(evaluate::planPrediction(plan.manifest, machine.x.resolution_mm).c_str(), stdout);
   return 0;
 }
 
 int cmdResolution(const std::string& artifact_file, const std::string& machine_file, double step_um) {
   const auto plan = planner::planSphereCycle(parts::loadSphereArtifact(artifact_file),
                                              parts::loadMachine(machine_file));
-  printResolution(evaluate::locationErrorResolution(plan.manifest, step_um * 1e-3), step_um);
-  printPrediction(plan.manifest);
+  std::fputs((evaluate::sphereResolutionText(evaluate::locationErrorResolution(plan.manifest, step_um * 1e-3), step_um) +
+              evaluate::spherePredictionText(plan.manifest))
+                 .c_str(),
+             stdout);
   return 0;
 }
 
@@ -163,53 +131,38 @@ int cmdSimulate(const std::string& program_file, const std::string& machine_file
   return 0;
 }
 
-int cmdEvaluate(const std::string& points_file, const std::string& manifest_file,
-                const std::string& out_dir, const std::string& format, bool free_radius,
-                const std::string& scene_file, double exaggeration) {
+int cmdEvaluate(const std::string& points_file, const std::string& manifest_file, const std::string& out_dir,
+                const std::string& format, bool free_radius, const std::string& scene_file, double exaggeration,
+                const std::string& compare_with) {
   const auto m = parts::readManifest(manifest_file);
-  const auto records = evaluate::readProbeRecords(points_file, evaluate::parsePointsFormat(format), m);
-  evaluate::EvaluateOptions opt;
-  opt.known_radius = !free_radius;
-  const auto e = evaluate::evaluateSphereCampaign(m, records, opt);
-  writeFileAtomic(join(out_dir, "errors.csv"), evaluate::errorSeriesCsv(e));
-  writeFileAtomic(join(out_dir, "evaluation.json"), evaluate::evaluationJson(e, m));
-  writeFileAtomic(join(out_dir, "report.md"), evaluate::evaluationReport(e, m));
-
-  std::printf("Location errors of the C axis relative to cycle %d (least squares; U for k = 2)\n",
-              e.reference_cycle);
-  std::printf("%6s %9s", "cycle", "time_s");
-  for (const auto* n : geometry::LocationErrors::names()) std::printf(" %17s", n);
-  std::printf("\n");
-  for (const auto& c : e.cycles) {
-    std::printf("%6d %9.0f", c.cycle, c.time_s);
-    for (const auto& b : c.budgets)
-      std::printf(" %8.3f +- %5.3f", b.value, b.U);
-    std::printf("\n");
-  }
-  if (e.formulas_applicable) {
-    double worst = 0;
-    for (const auto& c : e.cycles)
-      for (int j = 0; j < 7; ++j)
-        worst = std::max(worst, std::fabs(c.formulas->values()[j] - c.least_squares.values()[j]));
-    std::printf("Seed 004 Eqs. 5.4-5.10 on positions %d,%d,%d,%d agree with least squares to %.1e\n",
-                e.formula_positions[0], e.formula_positions[1], e.formula_positions[2],
-                e.formula_positions[3], worst);
-  }
-  for (const auto& [c, why] : e.incomplete)
-    std::printf("Cycle %d not evaluated: %s\n", c, why.c_str());
-  std::printf("Wrote %s, %s (budgets) and %s (report)\n", join(out_dir, "errors.csv").c_str(),
-              join(out_dir, "evaluation.json").c_str(), join(out_dir, "report.md").c_str());
-
-  if (!scene_file.empty()) {
+  evaluate::EvaluateRequest req;
+  req.input_file = points_file;
+  req.format = format;
+  req.free_radius = free_radius;
+  req.compare_with = compare_with;
+  req.out_dir = out_dir;
+  const auto f = evaluate::evaluateTestPiece(m, req);
+  std::string scene;
+  if (!scene_file.empty() && f.sphere) {
     std::vector<report::CycleCentres> cc;
-    for (const auto& c : e.cycles) {
+    for (const auto& c : f.sphere->cycles) {
       report::CycleCentres x;
       x.cycle = c.cycle;
       for (const auto& s : c.spheres) x.centre_mm.push_back(s.centre_mm());
       cc.push_back(x);
     }
-    writeFileAtomic(scene_file, report::campaignSceneGltf(m, cc, e.reference_cycle, exaggeration));
-    std::printf("Wrote %s (error vectors x%s)\n", scene_file.c_str(), formatNumber(exaggeration).c_str());
+    scene = report::campaignSceneGltf(m, cc, f.sphere->reference_cycle, exaggeration);
+  } else if (!scene_file.empty()) {
+    scene = report::thermalTestPieceSceneGltf(m, nlohmann::json::parse(f.evaluation_json), exaggeration);
+  }
+  writeFileAtomic(join(out_dir, evaluate::EvaluationFiles::kErrorsCsv), f.errors_csv);
+  writeFileAtomic(join(out_dir, evaluate::EvaluationFiles::kEvaluationJson), f.evaluation_json);
+  writeFileAtomic(join(out_dir, evaluate::EvaluationFiles::kReportMd), f.report_md);
+  std::fputs(f.stdout_text.c_str(), stdout);
+  if (!scene.empty()) {
+    writeFileAtomic(scene_file, scene);
+    std::printf("Wrote %s (%s x%s)\n", scene_file.c_str(), f.sphere ? "error vectors" : "deviation vectors",
+                formatNumber(exaggeration).c_str());
   }
   return 0;
 }
@@ -291,8 +244,8 @@ int main(int argc, char** argv) {
   std::uint64_t seed = 1;
   bool free_radius = false;
 
-  auto* plan = app.add_subcommand("plan", "Sphere-artifact probing cycle: G-code + plan manifest");
-  plan->add_option("artifact", artifact, "sphere artifact description (YAML)")->required()->check(CLI::ExistingFile);
+  auto* plan = app.add_subcommand("plan", "Programs (G-code) and the plan manifest for a test piece: sphere artifact, thermal test piece");
+  plan->add_option("piece", artifact, "test-piece description (YAML, kind: sphere_artifact | thermal_test_piece)")->required()->check(CLI::ExistingFile);
   plan->add_option("--machine", machine, "machine description (YAML)")->required()->check(CLI::ExistingFile);
   plan->add_option("--out", out, "output folder")->capture_default_str();
   plan->add_option("--dialect", dialect, "machine (from the machine file), linuxcnc or fanuc")
@@ -323,14 +276,18 @@ int main(int argc, char** argv) {
                    "(feature,point,x_mm,y_mm,z_mm,nx,ny,nz)")->check(CLI::ExistingFile);
   simc->add_flag("--trace", sim_trace, "also write trace.csv: every motion, dwell and tool change with its time and line");
 
-  auto* ev = app.add_subcommand("evaluate", "Location errors of the C axis from probe logs or points CSV");
-  ev->add_option("points", points, "LinuxCNC log, Fanuc DPRNT output or points CSV")->required()->check(CLI::ExistingFile);
+  std::string compare_with;
+  auto* ev = app.add_subcommand("evaluate", "Errors of a test piece from probe logs, points CSV, a CMM export or dial-gauge readings");
+  ev->add_option("points", points, "LinuxCNC log, Fanuc DPRNT output, points CSV, CMM export or gauge CSV")->required()->check(CLI::ExistingFile);
   ev->add_option("--manifest", manifest, "plan manifest (plan.json)")->required()->check(CLI::ExistingFile);
   ev->add_option("--out", out, "output folder")->capture_default_str();
-  ev->add_option("--format", format, "auto, linuxcnc, fanuc or csv")->capture_default_str();
+  ev->add_option("--format", format, "auto, linuxcnc, fanuc, csv, cmm or gauge")
+      ->check(CLI::IsMember({"auto", "linuxcnc", "fanuc", "csv", "cmm", "gauge"}))->capture_default_str();
   ev->add_flag("--free-radius", free_radius, "sphere centres from the free-radius fit (default: known radius)");
-  ev->add_option("--scene", scene, "also write a glTF scene of the campaign");
+  ev->add_option("--scene", scene, "also write a glTF scene (the sphere campaign, or the test piece with its deviations)");
   ev->add_option("--exaggeration", exaggeration, "scale of the error vectors in the scene")->capture_default_str();
+  ev->add_option("--compare", compare_with, "thermal test piece: another run's evaluation.json (seed 004 Table 7.2 reductions)")
+      ->check(CLI::ExistingFile);
 
   FitArgs fa;
   auto* fit = app.add_subcommand("fit", "Fit one geometric element to a point cloud (CSV, NIST .ds, XYZ, PLY)");
@@ -368,17 +325,20 @@ int main(int argc, char** argv) {
 
   CLI::App* model_group = nullptr;
   const auto run_model = cli::addModelCommands(app, model_group);
+  CLI::App* report_group = nullptr;
+  const auto run_report = cli::addReportCommands(app, report_group);
 
   CLI11_PARSE(app, argc, argv);
   try {
     if (*model_group) return run_model();
+    if (*report_group) return run_report();
     if (*plan) return cmdPlan(artifact, machine, out, dialect);
     if (*res) return cmdResolution(artifact, machine, step_um);
     if (*syn) return cmdSynth(manifest, truth, out, seed);
     if (*simc) return cmdSimulate(program, machine, part, truth, out, seed, cmm_points, sim_trace);
     if (*fit) return cmdFit(fa);
     if (*gum) return cmdGum(gum_model, gum_mcm || gum_trials > 0, gum_trials, seed, gum_digits, gum_json);
-    if (*ev) return cmdEvaluate(points, manifest, out, format, free_radius, scene, exaggeration);
+    if (*ev) return cmdEvaluate(points, manifest, out, format, free_radius, scene, exaggeration, compare_with);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "probeloop: error: %s\n", e.what());
     return 1;

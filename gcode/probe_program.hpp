@@ -1,4 +1,5 @@
-// A dialect-neutral probing program: what the planner decides, before any dialect.
+// The sphere-artifact probing program (planner/sphere_cycle.hpp) on the dialect-neutral ops
+// of gcode/program.hpp.
 //
 // Contract: coordinates are program coordinates in mm (= machine coordinates of the
 // stylus-tip centre, since the program zeroes its work offset and applies the probe's
@@ -7,29 +8,12 @@
 // closes it after. Every probing op names (position, point) for the log line
 // "PT <cycle> <position> <point> <x> <y> <z>".
 #pragma once
-#include <optional>
 #include <string>
-#include <variant>
 #include <vector>
 
+#include "gcode/program.hpp"
+
 namespace probeloop::gcode {
-
-struct Comment { std::string text; };
-// G0 in program coordinates; absent components are not moved.
-struct Rapid { std::optional<double> x, y, z; };
-// G0 in machine coordinates (G53), Z only: the tool-change height.
-struct RapidMachineZ { double z_mm; };
-struct RotateC { double c_deg; };
-struct ToolChange { int tool; bool apply_length_offset; };
-// A move near the artifact that must not touch it: contact stops the program.
-struct ProtectedMove { double x, y, z, feed_mm_per_min; };
-// The measuring move: stops at contact and logs the trigger point; no contact within the
-// move stops the program.
-struct ProbeMove { double x, y, z, feed_mm_per_min; int position, point; };
-struct Dwell { double seconds; };
-
-using Op = std::variant<Comment, Rapid, RapidMachineZ, RotateC, ToolChange, ProtectedMove,
-                        ProbeMove, Dwell>;
 
 struct ProbeProgram {
   std::string title;

@@ -1,8 +1,14 @@
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
 
 #include "core/csv.hpp"
 #include "gcode/probe_program.hpp"
+#include "gcode/program.hpp"
 
 namespace probeloop::gcode {
 namespace {
@@ -49,6 +55,17 @@ const char* wcs(int n) {
 // Lines both dialects write identically.
 std::string rapidLine(const Rapid& r) { return "G0" + axes(r) + "\n"; }
 std::string rotateLine(const RotateC& r) { return "G0 C" + n3(r.c_deg) + "\n"; }
+std::string rotateBLine(const RotateB& r) { return "G0 B" + n3(r.b_deg) + "\n"; }
+// Spindle speeds are whole rpm on every control.
+std::string spindleLine(const Spindle& s) {
+  return s.rpm > 0 ? "S" + formatNumber(s.rpm, 0) + " M3\n" : std::string("M5\n");
+}
+std::string coolantLine(const Coolant& c) { return c.on ? "M8\n" : "M9\n"; }
+std::string feedLine(const Feed& f) {
+  std::string s = "G1" + axes(Rapid{f.x, f.y, f.z});
+  if (f.c) s += " C" + n3(*f.c);
+  return s + " F" + n3(f.feed) + "\n";
+}
 std::string toolChangeLines(const ToolChange& t) {
   return "T" + std::to_string(t.tool) + " M6\n" +
          (t.apply_length_offset ? "G43 H" + std::to_string(t.tool) : std::string("G49")) + "\n";
@@ -58,6 +75,8 @@ std::string toolChangeLines(const ToolChange& t) {
 struct LinuxWriter {
   std::ostringstream out;
   int label = 200;
+  std::string check_hint = "check the artifact position";  // what the ABORT message tells the operator
+  std::vector<std::pair<int, std::string>> loops;  // open o-while: label, parameter name
 
   void op(const Op& o) {
     std::visit(Overloaded{
@@ -71,8 +90,7 @@ struct LinuxWriter {
           const int l = label++;
           out << "G38.3" << xyz(m.x, m.y, m.z) << " F" << n3(m.feed_mm_per_min) << "\n";
           out << "o" << l << " if [#5070 EQ 1]\n";
-          out << "  (ABORT,probeloop: unexpected contact during a protected move - check the "
-                 "artifact position)\n";
+          out << "  (ABORT,probeloop: unexpected contact during a protected move - " << check_hint << ")\n";
           out << "o" << l << " endif\n";
         },
         [&](const ProbeMove& m) {
@@ -83,12 +101,30 @@ struct LinuxWriter {
               << " #5061 #5062 #5063)\n";
         },
         [&](const Dwell& d) { out << "G4 P" << n3(d.seconds) << "\n"; },
+        [&](const RotateB& r) { out << rotateBLine(r); },
+        [&](const Spindle& sp) { out << spindleLine(sp); },
+        [&](const Coolant& c) { out << coolantLine(c); },
+        [&](const Feed& f) { out << feedLine(f); },
+        [&](const LoopBegin& l) {
+          const int lb = label++;
+          loops.emplace_back(lb, l.name);
+          out << "#<" << l.name << "> = 1\n";
+          out << "o" << lb << " while [#<" << l.name << "> LE " << l.count << "]\n";
+        },
+        [&](const LoopEnd&) {
+          if (loops.empty()) throw std::invalid_argument("a loop end without a loop begin");
+          const auto [lb, name] = loops.back();
+          loops.pop_back();
+          out << "#<" << name << "> = [#<" << name << "> + 1]\n";
+          out << "o" << lb << " endwhile\n";
+        },
     }, o);
   }
 };
 
 struct FanucWriter {
   std::ostringstream out;
+  int depth = 0;  // open WHILE ... DO levels
 
   void op(const Op& o) {
     std::visit(Overloaded{
@@ -114,6 +150,24 @@ struct FanucWriter {
               << "*#5061[44]*#5062[44]*#5063[44]]\n";
         },
         [&](const Dwell& d) { out << "G4 X" << n3(d.seconds) << "\n"; },
+        [&](const RotateB& r) { out << rotateBLine(r); },
+        [&](const Spindle& sp) { out << spindleLine(sp); },
+        [&](const Coolant& c) { out << coolantLine(c); },
+        [&](const Feed& f) { out << feedLine(f); },
+        [&](const LoopBegin& l) {
+          // Macro B nests WHILE ... DO1..DO3; #101.. count the loops (#100 is the log's cycle).
+          if (++depth > 3) throw std::invalid_argument("loops nested deeper than 3 (Fanuc WHILE ... DO1..DO3)");
+          const std::string v = "#" + std::to_string(100 + depth);
+          out << v << "=1\n";
+          out << "WHILE [" << v << " LE " << l.count << "] DO" << depth << "\n";
+        },
+        [&](const LoopEnd&) {
+          if (depth == 0) throw std::invalid_argument("a loop end without a loop begin");
+          const std::string v = "#" + std::to_string(100 + depth);
+          out << v << "=" << v << "+1\n";
+          out << "END" << depth << "\n";
+          --depth;
+        },
     }, o);
   }
   static std::string upper(std::string s) {
@@ -122,7 +176,62 @@ struct FanucWriter {
   }
 };
 
+// A program that probes must open its log; loops must close.
+void checkProgram(const Program& p) {
+  int depth = 0;
+  for (const auto& op : p.ops) {
+    if (std::holds_alternative<LoopBegin>(op)) ++depth;
+    if (std::holds_alternative<LoopEnd>(op) && --depth < 0)
+      throw std::invalid_argument(p.title + ": a loop end without a loop begin");
+    if (std::holds_alternative<ProbeMove>(op) && p.log_file.empty())
+      throw std::invalid_argument(p.title + ": a probe move in a program that opens no log");
+  }
+  if (depth != 0) throw std::invalid_argument(p.title + ": a loop is never closed");
+}
+
 }  // namespace
+
+std::string writeLinuxCnc(const Program& p) {
+  checkProgram(p);
+  LinuxWriter w;
+  w.label = 100;
+  w.check_hint = "check the part position and the clearances";
+  auto& o = w.out;
+  o << "(" << clean(p.title) << ")\n";
+  for (const auto& h : p.header) o << "(" << clean(h) << ")\n";
+  o << "G21 G90 G17 G40 G49 G80 G94\n";
+  o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_b_axis) << "\n";
+  o << wcs(p.work_offset) << "\n";
+  if (!p.log_file.empty()) {
+    o << "(LOGOPEN," << p.log_file << ")\n";
+    o << "#<_pl_cycle> = 1\n";
+  }
+  for (const auto& op : p.ops) w.op(op);
+  if (!p.log_file.empty()) o << "(LOGCLOSE)\n";
+  o << "M2\n";
+  return o.str();
+}
+
+std::string writeFanucMacroB(const Program& p) {
+  checkProgram(p);
+  FanucWriter w;
+  auto& o = w.out;
+  o << "%\n";
+  o << "O" << p.number << " (" << FanucWriter::upper(clean(p.title)) << ")\n";
+  for (const auto& h : p.header) o << "(" << FanucWriter::upper(clean(h)) << ")\n";
+  o << "G21 G90 G17 G40 G49 G80 G94\n";
+  o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_b_axis) << "\n";
+  o << wcs(p.work_offset) << "\n";
+  if (!p.log_file.empty()) {
+    o << "POPEN\n";
+    o << "#100=1\n";
+  }
+  for (const auto& op : p.ops) w.op(op);
+  if (!p.log_file.empty()) o << "PCLOS\n";
+  o << "M30\n";
+  o << "%\n";
+  return o.str();
+}
 
 std::string writeLinuxCnc(const ProbeProgram& p) {
   LinuxWriter w;

@@ -94,6 +94,7 @@ std::string genericManifestJson(const PlanManifest& m) {
   j["version"] = 1;
   j["kind"] = m.kind;
   j["dialect"] = m.dialect;
+  j["programs"] = ordered_json::array();
   for (const auto& p : m.programs)
     j["programs"].push_back({{"file", p.file}, {"dialect", p.dialect}, {"log_file", p.log_file}, {"role", p.role},
                              {"start_s", p.start_s}, {"duration_s", p.duration_s}});

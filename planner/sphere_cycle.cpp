@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 
 #include "core/csv.hpp"
 #include "core/error.hpp"
@@ -99,6 +100,11 @@ class Walker {
     gauge_ = contact_ + Vector3d(0, 0, length_);
   }
   void step(const gcode::Dwell&, const std::string&) {}  // no dwell inside a cycle
+  // Ops of machining programs (spindle, feeds, loops ...) the sphere cycle never emits.
+  template <class T>
+  void step(const T&, const std::string& where) {
+    throw std::logic_error(where + ": an op the sphere-cycle walker does not time");
+  }
 
   const Machine& m_;
   CycleTime& t_;
@@ -240,7 +246,11 @@ SpherePlan planSphereCycle(const SphereArtifact& a, const Machine& m, const Plan
   prog.cycles = cycles;
 
   man.dialect = parts::dialectName(m.dialect);
-  man.programs.push_back({files.program_file, man.dialect, files.log_file});
+  parts::ManifestProgram program;
+  program.file = files.program_file;
+  program.dialect = man.dialect;
+  program.log_file = files.log_file;
+  man.programs.push_back(program);
   man.machine_name = m.name;
   man.c_axis_centre_mm = m.c_axis_centre_mm;
   man.c_positive_is_clockwise = m.c.positive_is_clockwise;

@@ -1,0 +1,112 @@
+#include "cli/report_commands.hpp"
+
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+#include "parts/plan_manifest.hpp"
+#include "report/ttp_report.hpp"
+#include "report/ttp_scene.hpp"
+
+namespace probeloop::cli {
+namespace {
+
+struct TtpArgs {
+  std::string evaluation, second, r_test, html, scene, manifest;
+  double exaggeration = 1000;
+  report::TtpReportOptions options;
+};
+
+nlohmann::json readJson(const std::string& path) {
+  const std::string text = readFile(path);
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(path, 0, std::string("not valid JSON (") + e.what() + ")");
+  }
+}
+
+// The report and scene name no file in the errors they cannot place (the scene's evaluation).
+template <class F>
+auto naming(const std::string& file, F&& f) {
+  try {
+    return f();
+  } catch (const InputError& e) {
+    if (!e.file().empty()) throw;
+    throw InputError(file, 0, e.what());
+  }
+}
+
+int runTtp(TtpArgs a) {
+  if (a.html.empty() && a.scene.empty())
+    throw InputError("", 0, "report ttp: nothing to write; give --html and/or --scene");
+  const nlohmann::json evaluation = readJson(a.evaluation);
+  std::optional<nlohmann::json> second;
+  if (!a.second.empty()) second = readJson(a.second);
+  std::optional<std::string> r_test;
+  if (!a.r_test.empty()) r_test = readFile(a.r_test);
+  a.options.evaluation_file = a.evaluation;
+  a.options.second_file = a.second;
+  a.options.r_test_file = a.r_test;
+
+  if (!a.html.empty()) {
+    const std::string html = report::thermalTestPieceReportHtml(evaluation, second ? &*second : nullptr,
+                                                                r_test ? &*r_test : nullptr, report::defaultVegaPath(),
+                                                                a.options);
+    writeFileAtomic(a.html, html);
+    std::printf("Wrote %s (thermal-test-piece report: %s%s%s)\n", a.html.c_str(), a.evaluation.c_str(),
+                second ? (" and " + a.second).c_str() : "", r_test ? (", R-test " + a.r_test).c_str() : "");
+  }
+  if (!a.scene.empty()) {
+    const parts::PlanManifest manifest = parts::readManifest(a.manifest);
+    const std::string gltf = naming(a.evaluation, [&] {
+      return report::thermalTestPieceSceneGltf(manifest, evaluation, a.exaggeration);
+    });
+    writeFileAtomic(a.scene, gltf);
+    std::printf("Wrote %s (glTF scene of %s, deviation vectors x%g)\n", a.scene.c_str(), a.manifest.c_str(),
+                a.exaggeration);
+  }
+  return 0;
+}
+
+}  // namespace
+
+std::function<int()> addReportCommands(CLI::App& app, CLI::App*& group) {
+  auto a = std::make_shared<TtpArgs>();
+  group = app.add_subcommand("report", "Reports of evaluated test pieces: HTML pages and glTF scenes");
+  group->require_subcommand(1);
+  auto* ttp = group->add_subcommand(
+      "ttp", "Thermal test piece (seed 004 Ch. 7): E_X, E_Y, E_Z, E_B, E_TTP and dT against time beside the R-test, "
+             "spans, budgets (HTML); the piece with its deviations (glTF)");
+  ttp->add_option("--evaluation", a->evaluation, "evaluation.json of `probeloop evaluate` (thermal test piece)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  ttp->add_option("--second", a->second, "the other route's evaluation.json of the same piece (CMM vs on-machine)")
+      ->check(CLI::ExistingFile);
+  ttp->add_option("--r-test", a->r_test, "errors.csv of an R-test (sphere cycle) on the same clock")
+      ->check(CLI::ExistingFile);
+  ttp->add_option("--html", a->html, "write the HTML report to this file");
+  auto* manifest = ttp->add_option("--manifest", a->manifest, "plan.json of the test piece (for --scene)")
+                       ->check(CLI::ExistingFile);
+  ttp->add_option("--scene", a->scene, "write a glTF scene of the piece with its deviations to this file")
+      ->needs(manifest);
+  ttp->add_option("--exaggeration", a->exaggeration, "scale of the deviation vectors in the scene")
+      ->capture_default_str();
+  ttp->add_option("--table-alpha", a->options.table_alpha_um_per_m_K,
+                  "Eq. 7.10 for the table: expansion coefficient, um/(m K) (seed 004: cast iron)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  ttp->add_option("--r-test-radius", a->options.r_test_radius_mm,
+                  "Eq. 7.10 for the table: the R-test sphere's radius from the C axis, mm")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  return [a, ttp]() -> int {
+    if (*ttp) return runTtp(*a);
+    return 2;
+  };
+}
+
+}  // namespace probeloop::cli

@@ -1,0 +1,166 @@
+#include "evaluate/test_piece.hpp"
+
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <filesystem>
+
+#include "core/atomic_file.hpp"
+#include "core/csv.hpp"
+#include "core/error.hpp"
+#include "evaluate/ingest.hpp"
+#include "evaluate/ttp_ingest.hpp"
+
+namespace probeloop::evaluate {
+
+namespace {
+
+// printf into a string (the sphere's texts were printed with these formats; byte-identical).
+void appendf(std::string& out, const char* fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  va_list ap2;
+  va_copy(ap2, ap);
+  const int n = std::vsnprintf(nullptr, 0, fmt, ap);
+  va_end(ap);
+  if (n > 0) {
+    std::string buf(static_cast<std::size_t>(n) + 1, '\0');
+    std::vsnprintf(buf.data(), buf.size(), fmt, ap2);
+    buf.resize(static_cast<std::size_t>(n));
+    out += buf;
+  }
+  va_end(ap2);
+}
+
+std::string join(const std::string& dir, const std::string& file) { return (std::filesystem::path(dir) / file).string(); }
+
+EvaluationFiles sphere(const parts::PlanManifest& m, const EvaluateRequest& r) {
+  const auto records = readProbeRecords(r.input_file, parsePointsFormat(r.format), m);
+  EvaluateOptions opt;
+  opt.known_radius = !r.free_radius;
+  EvaluationFiles f;
+  f.sphere = evaluateSphereCampaign(m, records, opt);
+  const auto& e = *f.sphere;
+  f.errors_csv = errorSeriesCsv(e);
+  f.evaluation_json = evaluationJson(e, m);
+  f.report_md = evaluationReport(e, m);
+  f.stdout_text = sphereEvaluationStdout(e, r.out_dir);
+  return f;
+}
+
+EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateRequest& r) {
+  if (r.free_radius) throw InputError(r.input_file, 0, "--free-radius applies to sphere-artifact campaigns, not to the thermal test piece");
+  const std::string text = readFile(r.input_file);
+  const std::string fmt = r.format == "auto" ? detectTtpFormat(r.input_file, text) : r.format;
+  TtpOptions opt;
+  opt.gauge_resolution_um = r.gauge_resolution_um;
+  TtpEvaluation e;
+  if (fmt == "cmm") {
+    e = evaluateThermalTestPiece(m, readTtpCmmExport(r.input_file, text, m), opt);
+  } else if (fmt == "linuxcnc" || fmt == "fanuc" || fmt == "log" || fmt == "csv") {
+    e = evaluateThermalTestPiece(m, readTtpOnMachine(r.input_file, text, fmt, m), opt);
+  } else if (fmt == "gauge") {
+    if (!(r.gauge_resolution_um > 0)) throw InputError("", 0, "the gauge resolution must be positive");
+    e = evaluateThermalTestPieceGauge(m, readTtpGauge(r.input_file, text, m), opt);
+  } else {
+    throw InputError("", 0, "--format '" + r.format + "': expected auto, cmm, linuxcnc, fanuc, csv or gauge");
+  }
+  if (!r.compare_with.empty()) e.comparison = compareSpans(e.spans, r.compare_with);
+  EvaluationFiles f;
+  f.errors_csv = ttpErrorsCsv(e);
+  f.evaluation_json = ttpEvaluationJson(e);
+  f.report_md = ttpReport(e);
+  f.stdout_text = ttpStdout(e, join(r.out_dir, EvaluationFiles::kErrorsCsv), join(r.out_dir, EvaluationFiles::kEvaluationJson),
+                            join(r.out_dir, EvaluationFiles::kReportMd));
+  f.thermal_test_piece = std::move(e);
+  return f;
+}
+
+}  // namespace
+
+EvaluationFiles evaluateTestPiece(const parts::PlanManifest& m, const EvaluateRequest& r) {
+  if (m.kind == "sphere_artifact") {
+    if (!r.compare_with.empty())
+      throw InputError("", 0, "--compare applies to the thermal test piece (seed 004 Table 7.2), not to a sphere-artifact campaign");
+    return sphere(m, r);
+  }
+  if (m.kind == "thermal_test_piece") return thermalTestPiece(m, r);
+  throw InputError(m.file, 0, "manifest kind '" + m.kind + "': evaluate knows sphere_artifact and thermal_test_piece");
+}
+
+std::string sphereEvaluationStdout(const CampaignEvaluation& e, const std::string& out_dir) {
+  std::string o;
+  appendf(o, "Location errors of the C axis relative to cycle %d (least squares; U for k = 2)\n", e.reference_cycle);
+  appendf(o, "%6s %9s", "cycle", "time_s");
+  for (const auto* n : geometry::LocationErrors::names()) appendf(o, " %17s", n);
+  appendf(o, "\n");
+  for (const auto& c : e.cycles) {
+    appendf(o, "%6d %9.0f", c.cycle, c.time_s);
+    for (const auto& b : c.budgets) appendf(o, " %8.3f +- %5.3f", b.value, b.U);
+    appendf(o, "\n");
+  }
+  if (e.formulas_applicable) {
+    double worst = 0;
+    for (const auto& c : e.cycles)
+      for (int j = 0; j < 7; ++j) worst = std::max(worst, std::fabs(c.formulas->values()[j] - c.least_squares.values()[j]));
+    appendf(o, "Seed 004 Eqs. 5.4-5.10 on positions %d,%d,%d,%d agree with least squares to %.1e\n", e.formula_positions[0],
+            e.formula_positions[1], e.formula_positions[2], e.formula_positions[3], worst);
+  }
+  for (const auto& [c, why] : e.incomplete) appendf(o, "Cycle %d not evaluated: %s\n", c, why.c_str());
+  appendf(o, "Wrote %s, %s (budgets) and %s (report)\n", join(out_dir, EvaluationFiles::kErrorsCsv).c_str(),
+          join(out_dir, EvaluationFiles::kEvaluationJson).c_str(), join(out_dir, EvaluationFiles::kReportMd).c_str());
+  return o;
+}
+
+std::string sphereResolutionText(const Resolution& r, double step_um) {
+  std::string o;
+  appendf(o, "Resolution of the location errors for a %s um coordinate step (seed 004 Table 5.4):\n", formatNumber(step_um).c_str());
+  appendf(o, "  %-10s %16s %16s\n", "error", "Eqs. 5.4-5.10", "least squares");
+  for (int j = 0; j < 7; ++j) {
+    std::string n = geometry::LocationErrors::names()[j];
+    const std::string unit = j < 4 ? "um" : "um/m";
+    n = n.substr(0, n.find('_'));
+    const std::string f = r.formulas ? formatNumber((*r.formulas)[j], 4) + " " + unit : "n/a";
+    appendf(o, "  %-10s %16s %16s\n", n.c_str(), f.c_str(), (formatNumber(r.least_squares[j], 4) + " " + unit).c_str());
+  }
+  return o;
+}
+
+std::string spherePredictionText(const parts::PlanManifest& m) {
+  std::string o;
+  const auto b = predictLocationErrorBudgets(m);
+  appendf(o,
+          "Predicted expanded uncertainty (k = 2) of each error of a cycle, before measuring\n"
+          "(d/2 = %s mm, %d points per sphere; drift and the d/2 term depend on measured values):\n",
+          formatNumber(m.radius_from_axis_mm).c_str(), m.pointsPerSphere());
+  for (const auto& x : b)
+    appendf(o, "  %-6s U = %7s %-4s  largest: %s\n", x.quantity.c_str(), formatNumber(x.U, 3).c_str(), x.unit.c_str(),
+            x.contributions.empty() ? "" : x.contributions.front().input.c_str());
+  return o;
+}
+
+std::string planPrediction(const parts::PlanManifest& m, double step_mm) {
+  if (m.kind == "sphere_artifact")
+    return sphereResolutionText(locationErrorResolution(m, step_mm), step_mm * 1e3) + spherePredictionText(m);
+  if (m.kind != "thermal_test_piece") return "";
+  std::string o;
+  const auto p = predictThermalTestPiece(m);
+  if (!p.note.empty()) {
+    appendf(o, "No predicted uncertainty: %s\n", p.note.c_str());
+    return o;
+  }
+  appendf(o,
+          "Predicted expanded uncertainty (k = 2) of the thermal-test-piece errors, before measuring: from the planned\n"
+          "points and the specifications alone (type B point scatter; no measured values, so the type A scatter and the\n"
+          "terms that scale with the measured value are 0); per route the largest over the cutting cycles:\n");
+  appendf(o, "  %-11s %-8s %12s  %-6s %s\n", "route", "error", "U", "cycle", "largest contribution");
+  for (int route = 0; route < 2; ++route) {
+    const auto& v = route == 0 ? p.cmm : p.on_machine;
+    for (const auto& x : v)
+      appendf(o, "  %-11s %-8s %7s %-4s  %-6d %s\n", route == 0 ? "CMM" : "on-machine", x.quantity.c_str(), formatNumber(x.U, 3).c_str(),
+              x.unit.c_str(), x.cycle, x.largest.c_str());
+  }
+  return o;
+}
+
+}  // namespace probeloop::evaluate

@@ -1,0 +1,36 @@
+// The kind dispatch of `probeloop evaluate` / `probeloop plan` (the sphere artifact's outputs
+// are compared byte for byte with the previous CLI's in the integration check, see the report).
+#include "evaluate/test_piece.hpp"
+
+#include <gtest/gtest.h>
+
+#include "core/error.hpp"
+
+namespace probeloop::evaluate {
+namespace {
+
+std::string refusal(const parts::PlanManifest& m, const EvaluateRequest& r) {
+  try {
+    evaluateTestPiece(m, r);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(accepted)";
+}
+
+TEST(TestPieceDispatch, UnknownKindsAndMisplacedOptionsAreRefused) {
+  parts::PlanManifest m;
+  m.file = "plan.json";
+  m.kind = "stepped_workpiece";
+  EvaluateRequest r;
+  r.input_file = "points.csv";
+  EXPECT_NE(refusal(m, r).find("plan.json: manifest kind 'stepped_workpiece': evaluate knows sphere_artifact and thermal_test_piece"),
+            std::string::npos);
+  EXPECT_EQ(planPrediction(m, 0.001), "");
+  m.kind = "sphere_artifact";
+  r.compare_with = "other/evaluation.json";
+  EXPECT_NE(refusal(m, r).find("--compare applies to the thermal test piece"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace probeloop::evaluate

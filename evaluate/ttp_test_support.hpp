@@ -1,0 +1,263 @@
+// Test support for the thermal-test-piece evaluation: a plan manifest built by hand from the
+// shipped description (parts/: loadThermalTestPiece, nominalFeatures, cuttingCycles; no
+// planner), the inspection points of docs/thermal-test-piece.md §3 in the part frame, and
+// synthetic measurements of surfaces displaced by chosen amounts. The machine placement is
+// written out here (p_machine = c + Rz(s C) (p + origin - c), s = -1 when C+ is clockwise),
+// independently of evaluate/ttp_ingest.cpp.
+#pragma once
+#include <Eigen/Dense>
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "core/csv.hpp"
+#include "core/units.hpp"
+#include "parts/plan_manifest.hpp"
+#include "parts/thermal_test_piece.hpp"
+
+namespace probeloop::evaluate::ttptest {
+
+using Eigen::Vector3d;
+
+struct PlannedPoint {
+  std::string feature;
+  int position = 0, point = 0;
+  Vector3d surface_mm;  // part frame, nominal
+  Vector3d outward;     // part frame
+  double c_deg = 0;
+};
+
+struct Fixture {
+  parts::ThermalTestPiece t;
+  parts::PlanManifest m;
+  std::vector<PlannedPoint> planned;
+};
+
+inline Vector3d rotZ(const Vector3d& v, double deg) {
+  const double a = degToRad(deg), c = std::cos(a), s = std::sin(a);
+  return {c * v.x() - s * v.y(), s * v.x() + c * v.y(), v.z()};
+}
+
+inline double wrap180(double a) {
+  a = std::fmod(a, 360.0);
+  if (a > 180) a -= 360;
+  if (a <= -180) a += 360;
+  return a;
+}
+
+inline Fixture makeFixture(bool clockwise = true) {
+  Fixture f;
+  f.t = parts::loadThermalTestPiece(std::string(PROBELOOP_SOURCE_DIR) + "/parts/thermal_test_piece.yaml");
+  const auto& t = f.t;
+  auto& m = f.m;
+  m.file = "hand-built-plan.json";
+  m.kind = "thermal_test_piece";
+  m.dialect = "fanuc";
+  m.machine_name = "test machine";
+  m.programs.push_back({"inspection.nc", "fanuc", "dprnt.txt", "inspection", 0, 0});
+  m.c_axis_centre_mm = {12.5, -7.25};
+  m.c_positive_is_clockwise = clockwise;
+  m.table_surface_z_mm = 100;
+  m.coordinate_resolution_mm = 0.001;
+  m.probe_tool = 20;
+  m.tip_radius_mm = 3;
+  m.probe_repeatability_2sigma_um = 1;
+  m.part_name = t.name;
+  m.part_origin_mm = parts::partOriginOnMachine(t, m.c_axis_centre_mm, m.table_surface_z_mm);
+  m.material_name = t.material.name;
+  m.material_alpha_um_per_m_K = t.material.alpha_per_K * 1e6;
+  m.ttp.z_paths = t.z_paths;
+  m.ttp.facets_per_segment = t.facets_per_segment;
+  m.ttp.facet_apothem_mm = t.facet_apothem_mm;
+  m.ttp.test_tool_radius_mm = t.tool(t.test_tool)->diameter_mm / 2;
+  m.ttp.eq_7_10_alpha_um_per_m_K = t.eq_7_10_alpha_um_per_m_K;
+  m.ttp.alpha_u_um_per_m_K = t.alpha_u_um_per_m_K;
+  m.ttp.eq_7_10_radius_mm = t.eq_7_10_radius_mm;
+  m.ttp.cmm = t.cmm;
+  m.ttp.on_machine_repeatability_um = t.on_machine_repeatability_um;
+  m.ttp.on_machine_temperature_change_K = t.on_machine_temperature_change_K;
+  const auto cycles = parts::cuttingCycles(t);
+  for (const auto& c : cycles) {
+    parts::ManifestCycle x;
+    x.cycle = c.cycle;
+    x.phase = c.phase;
+    x.c_axis_rpm_before = c.c_axis_rpm_before;
+    x.start_s = c.nominal_time_s;
+    x.end_s = c.nominal_time_s + 300;
+    x.z_path = c.z_path;
+    x.facet = c.facet;
+    m.cut_cycles.push_back(x);
+  }
+  int position = 0;
+  const std::map<std::string, double> cut_offset{{"Z", 30}, {"X1", 90}, {"Y1", 150}, {"X2", 210}, {"Y2", 270}};
+  for (const auto& n : parts::nominalFeatures(t)) {
+    parts::ManifestFeature mf;
+    mf.nominal = n;
+    if (n.role == "z_path" || n.role == "facet")
+      for (const auto& c : cycles)
+        if ((n.role == "z_path" ? c.z_path : c.facet) == n.index) {
+          mf.cycle = c.cycle;
+          mf.cut_time_s = c.nominal_time_s + cut_offset.at(n.group);
+        }
+    mf.position = ++position;
+    m.features.push_back(mf);
+  }
+  // Inspection points (docs/thermal-test-piece.md §3), part frame surface points.
+  const double s = clockwise ? -1.0 : 1.0;
+  auto add = [&](const parts::ManifestFeature& mf, const Vector3d& p, const Vector3d& n, double c_deg) {
+    PlannedPoint q;
+    q.feature = mf.nominal.id;
+    q.position = mf.position;
+    q.surface_mm = p;
+    q.outward = n;
+    q.c_deg = c_deg;
+    int k = 0;
+    for (const auto& x : f.planned)
+      if (x.feature == q.feature) ++k;
+    q.point = k + 1;
+    f.planned.push_back(q);
+  };
+  const double r_band = t.datum_band_diameter_mm / 2;
+  for (const auto& mf : m.features) {
+    const auto& n = mf.nominal;
+    if (n.id == "TOP") {
+      for (double sx : {1.0, -1.0})
+        for (double sy : {1.0, -1.0})
+          for (const auto& xy : {Eigen::Vector2d(20, 70), Eigen::Vector2d(60, 65), Eigen::Vector2d(30, 88)})
+            add(mf, Vector3d(sx * xy.x(), sy * xy.y(), 0), Vector3d::UnitZ(), 0);
+    } else if (n.id == "FLANK_P" || n.id == "FLANK_N") {
+      for (double x : {-60.0, -20.0, 20.0, 60.0})
+        for (double z : {-3.0, -9.0}) add(mf, Vector3d(x, n.point_mm.y(), z), n.direction, 0);
+    } else if (n.id == "CYL") {
+      for (int k = 0; k < t.datum_circle_points; ++k) {
+        const double th = 15.0 + 360.0 * k / t.datum_circle_points;
+        add(mf, Vector3d(r_band * std::cos(degToRad(th)), r_band * std::sin(degToRad(th)), t.datum_circle_z_mm),
+            Vector3d(std::cos(degToRad(th)), std::sin(degToRad(th)), 0), wrap180(-th / s));
+      }
+    } else if (n.role == "z_path") {
+      for (double x : t.z_path_points_along_mm)
+        for (double a : t.z_path_points_across_mm) add(mf, Vector3d(x, n.point_mm.y() + a, n.point_mm.z()), Vector3d::UnitZ(), 0);
+    } else if (n.role == "facet") {
+      for (double a : t.facet_points_across_mm)
+        for (double h : t.facet_points_heights_mm) {
+          const Vector3d p = t.facet_apothem_mm * n.direction + a * n.u;
+          add(mf, Vector3d(p.x(), p.y(), h), n.direction, wrap180(-n.angle_deg / s));
+        }
+    }
+  }
+  for (const auto& q : f.planned) {
+    parts::ManifestPoint p;
+    p.feature = q.feature;
+    p.position = q.position;
+    p.point = q.point;
+    p.c_deg = q.c_deg;
+    // The placement on the machine, written out: p_m = c + Rz(s C)(p + origin - c).
+    const Vector3d c3(m.c_axis_centre_mm.x(), m.c_axis_centre_mm.y(), 0);
+    const Vector3d surface_m = c3 + rotZ(q.surface_mm + m.part_origin_mm - c3, s * q.c_deg);
+    const Vector3d outward_m = rotZ(q.outward, s * q.c_deg);
+    p.approach = -outward_m;
+    p.contact_mm = surface_m + m.tip_radius_mm * outward_m;
+    p.time_in_cycle_s = 0;
+    m.points.push_back(p);
+  }
+  return f;
+}
+
+// Displacements of the cut surfaces, by feature id: facets move along their outward normal
+// (mm); Z paths are cut deeper by `offset` (mm) and tilted by beta about +Y (a right-hand
+// angle, rad): the plane z = z_nom - offset - tan(beta) x, normal ~ (tan beta, 0, 1).
+struct Truth {
+  std::map<std::string, double> offset_mm, beta_rad;
+};
+
+struct Measured {
+  std::string feature;
+  int position = 0, point = 0;
+  Vector3d surface_mm;  // part frame
+  double c_deg = 0;
+  Vector3d outward;
+};
+
+inline std::vector<Measured> measure(const Fixture& f, const Truth& truth) {
+  std::vector<Measured> out;
+  for (const auto& q : f.planned) {
+    Measured x{q.feature, q.position, q.point, q.surface_mm, q.c_deg, q.outward};
+    const auto& nom = f.m.feature(q.feature)->nominal;
+    const double off = truth.offset_mm.count(q.feature) ? truth.offset_mm.at(q.feature) : 0.0;
+    if (nom.role == "facet") {
+      x.surface_mm += off * q.outward;
+    } else if (nom.role == "z_path") {
+      const double b = truth.beta_rad.count(q.feature) ? truth.beta_rad.at(q.feature) : 0.0;
+      x.surface_mm.z() = nom.point_mm.z() - off - std::tan(b) * x.surface_mm.x();
+    }
+    out.push_back(x);
+  }
+  return out;
+}
+
+// A CMM export: optional labels, points moved by p -> Q p + shift.
+inline std::string cmmCsv(const std::vector<Measured>& pts, bool labels, const Eigen::Matrix3d& Q = Eigen::Matrix3d::Identity(),
+                          const Vector3d& shift = Vector3d::Zero(), const std::string& label_prefix = "") {
+  std::ostringstream o;
+  o << "# synthetic CMM export\n" << (labels ? "feature,point," : "") << "x_mm,y_mm,z_mm\n";
+  for (const auto& p : pts) {
+    const Vector3d v = Q * p.surface_mm + shift;
+    if (labels) o << label_prefix << p.feature << "," << p.point << ",";
+    o << formatNumber(v.x()) << "," << formatNumber(v.y()) << "," << formatNumber(v.z()) << "\n";
+  }
+  return o.str();
+}
+
+// On-machine: tip centres in machine coordinates at each point's C.
+inline Vector3d tipCentre(const Fixture& f, const Measured& p) {
+  const auto& m = f.m;
+  const double s = m.c_positive_is_clockwise ? -1.0 : 1.0;
+  const Vector3d c3(m.c_axis_centre_mm.x(), m.c_axis_centre_mm.y(), 0);
+  const Vector3d surface_m = c3 + rotZ(p.surface_mm + m.part_origin_mm - c3, s * p.c_deg);
+  const Vector3d outward_m = rotZ(p.outward, s * p.c_deg);
+  return surface_m + m.tip_radius_mm * outward_m;  // square probing: the tip touches along the normal
+}
+
+inline std::string pointsCsv(const Fixture& f, const std::vector<Measured>& pts) {
+  std::ostringstream o;
+  o << "# synthetic on-machine points\ntime_s,cycle,c_deg,feature,point,x_mm,y_mm,z_mm,nx,ny,nz\n";
+  double t = 0;
+  for (const auto& p : pts) {
+    const Vector3d tip = tipCentre(f, p);
+    const double s = f.m.c_positive_is_clockwise ? -1.0 : 1.0;
+    const Vector3d a = -rotZ(p.outward, s * p.c_deg);
+    o << formatNumber(t += 2, 3) << ",1," << formatNumber(p.c_deg) << ",P" << p.position << "," << p.point << ","
+      << formatNumber(tip.x()) << "," << formatNumber(tip.y()) << "," << formatNumber(tip.z()) << "," << formatNumber(a.x()) << ","
+      << formatNumber(a.y()) << "," << formatNumber(a.z()) << "\n";
+  }
+  return o.str();
+}
+
+inline std::string dprnt(const Fixture& f, const std::vector<Measured>& pts) {
+  std::ostringstream o;
+  o << "%\n";
+  char buf[160];
+  for (const auto& p : pts) {
+    const Vector3d tip = tipCentre(f, p);
+    std::snprintf(buf, sizeof buf, "PT     1 %d %d %12.6f %12.6f %12.6f\n", p.position, p.point, tip.x(), tip.y(), tip.z());
+    o << buf;
+  }
+  return o.str();
+}
+
+inline std::string facetId(const Fixture& f, const std::string& side, int cycle) {
+  return side + "_" + std::to_string(f.t.order[static_cast<std::size_t>(cycle)]);
+}
+inline std::string zId(const Fixture& f, int cycle) { return "Z" + std::to_string(f.t.order[static_cast<std::size_t>(cycle)]); }
+
+inline std::string tempFile(const std::string& name, const std::string& text) {
+  static int n = 0;
+  const std::string p = std::string(::testing::TempDir()) + "probeloop-ttp-" + std::to_string(n++) + "-" + name;
+  std::ofstream(p) << text;
+  return p;
+}
+
+}  // namespace probeloop::evaluate::ttptest

@@ -1,0 +1,262 @@
+#include "planner/program_walker.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "core/csv.hpp"
+#include "core/error.hpp"
+
+namespace probeloop::planner {
+
+using Eigen::Vector3d;
+
+double round4(double v) {
+  const double r = std::round(v * 1e4) / 1e4;
+  return r == 0 ? 0.0 : r;  // no negative zero
+}
+double round3(double v) {
+  const double r = std::round(v * 1e3) / 1e3;
+  return r == 0 ? 0.0 : r;
+}
+
+namespace {
+template <class... Ts>
+struct Overloaded : Ts... { using Ts::operator()...; };
+template <class... Ts>
+Overloaded(Ts...) -> Overloaded<Ts...>;
+
+// Seconds a rotary axis needs to index by `delta` at its positioning speed (the simulator's
+// rotaryTime).
+double rotaryTime(double delta_deg, const parts::RotaryAxis& ax) {
+  if (delta_deg == 0) return 0;
+  return std::fabs(delta_deg) / (ax.max_speed_rpm * 360.0) * 60.0;
+}
+}  // namespace
+
+ProgramWalker::ProgramWalker(const parts::Machine& m, std::vector<WalkerTool> tools) : m_(m), tools_(std::move(tools)) {
+  // As the simulator: at rest at the top of Z, X and Y at the C axis.
+  gauge_ = Vector3d(std::clamp(m.c_axis_centre_mm.x(), m.x.min_mm, m.x.max_mm),
+                    std::clamp(m.c_axis_centre_mm.y(), m.y.min_mm, m.y.max_mm), m.z.max_mm);
+  tool_.number = m.tool_change.empty_tool;
+  WalkerTool empty;
+  empty.number = m.tool_change.empty_tool;
+  tools_.push_back(empty);
+  WalkerTool probe;
+  probe.number = m.probe.tool;
+  probe.length_mm = m.probe.length_mm;
+  probe.radius_mm = m.probe.tip_diameter_mm / 2;
+  probe.probe = true;
+  tools_.push_back(probe);
+}
+
+void ProgramWalker::fail(const OpNote& note, const std::string& message) const {
+  throw SafetyError((program_ ? *program_ + ": " : std::string()) + note.where + ": " + message);
+}
+
+const WalkerTool& ProgramWalker::toolFor(int number, const OpNote& note) const {
+  for (const auto& t : tools_)
+    if (t.number == number) return t;
+  fail(note, "tool T" + std::to_string(number) + " is neither one of the part's tools, the probe nor the empty spindle");
+}
+
+void ProgramWalker::checkTravel(const Vector3d& g, const OpNote& note, const char* what) const {
+  const parts::LinearAxis* ax[3] = {&m_.x, &m_.y, &m_.z};
+  const char* names = "XYZ";
+  for (int i = 0; i < 3; ++i)
+    if (g(i) < ax[i]->min_mm - 1e-9 || g(i) > ax[i]->max_mm + 1e-9) {
+      std::ostringstream s;
+      s << what << " needs " << names[i] << " = " << formatNumber(g(i), 3) << " mm (gauge line = tip + tool length "
+        << formatNumber(tool_.length_mm, 3) << " mm), outside the " << names[i] << " travel [" << formatNumber(ax[i]->min_mm, 3)
+        << ", " << formatNumber(ax[i]->max_mm, 3) << "] of " << m_.file;
+      fail(note, s.str());
+    }
+}
+
+void ProgramWalker::checkLinearFeed(double F, const OpNote& note, const char* what) const {
+  const double fmax = std::min({m_.x.max_feed_mm_per_min, m_.y.max_feed_mm_per_min, m_.z.max_feed_mm_per_min});
+  if (!(F > 0)) fail(note, std::string(what) + " without a feed rate");
+  if (F > fmax + 1e-9)
+    fail(note, std::string(what) + " at F" + formatNumber(F, 3) + " mm/min exceeds the machine's maximum feed " +
+                   formatNumber(fmax, 3) + " mm/min (slowest axis, " + m_.file + ")");
+}
+
+void ProgramWalker::motion(const char* what, const Vector3d& to_tip, double to_c, const OpNote& note) const {
+  if (!check_) return;
+  Motion mo;
+  mo.program = program_;
+  mo.note = &note;
+  mo.what = what;
+  mo.from_tip = tip();
+  mo.to_tip = to_tip;
+  mo.from_c = c_;
+  mo.to_c = to_c;
+  mo.tool = tool_;
+  check_(mo);
+}
+
+void ProgramWalker::run(const NotedProgram& p, const OpCallback& on_op) {
+  program_ = &p.file;
+  const auto& ops = p.program.ops;
+  // Loops: run the body `count` times (nested loops by recursion on the index range).
+  std::function<void(std::size_t, std::size_t)> range = [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      if (const auto* l = std::get_if<gcode::LoopBegin>(&ops[i])) {
+        int depth = 1;
+        std::size_t j = i + 1;
+        for (; j < end; ++j) {
+          if (std::holds_alternative<gcode::LoopBegin>(ops[j])) ++depth;
+          if (std::holds_alternative<gcode::LoopEnd>(ops[j]) && --depth == 0) break;
+        }
+        if (j >= end) fail(p.notes[i], "a loop without its end");
+        if (l->count < 0) fail(p.notes[i], "a loop with a negative count");
+        for (int k = 0; k < l->count; ++k) range(i + 1, j);
+        i = j;
+        continue;
+      }
+      const double t0 = t_;
+      step(ops[i], p.notes[i]);
+      if (on_op) on_op(i, t0, t_);
+    }
+  };
+  range(0, ops.size());
+  program_ = nullptr;
+}
+
+void ProgramWalker::step(const gcode::Op& op, const OpNote& note) {
+  const double L = tool_.length_mm;
+  std::visit(
+      Overloaded{
+          [&](const gcode::Comment&) {},
+          [&](const gcode::LoopBegin&) {},
+          [&](const gcode::LoopEnd&) {},
+          [&](const gcode::Rapid& r) {
+            Vector3d to = tip();
+            if (r.x) to.x() = *r.x;
+            if (r.y) to.y() = *r.y;
+            if (r.z) to.z() = *r.z;
+            const Vector3d g = to + Vector3d(0, 0, L);
+            checkTravel(g, note, "rapid move");
+            motion("rapid move", to, c_, note);
+            const double dt = (g - gauge_).cwiseAbs().maxCoeff() / m_.rapid_feed_mm_per_min * 60.0;
+            times_.rapid_s += dt;
+            t_ += dt;
+            gauge_ = g;
+          },
+          [&](const gcode::RapidMachineZ& r) {
+            const Vector3d g(gauge_.x(), gauge_.y(), r.z_mm);
+            checkTravel(g, note, "retract to the tool-change height");
+            motion("retract to the tool-change height", g - Vector3d(0, 0, L), c_, note);
+            const double dt = std::fabs(g.z() - gauge_.z()) / m_.rapid_feed_mm_per_min * 60.0;
+            times_.rapid_s += dt;
+            t_ += dt;
+            gauge_ = g;
+          },
+          [&](const gcode::RotateC& r) {
+            if (!m_.c.present) fail(note, "C move on a machine without a C axis (" + m_.file + ")");
+            if (!m_.c.continuous && (r.c_deg < m_.c.min_deg - 1e-9 || r.c_deg > m_.c.max_deg + 1e-9))
+              fail(note, "C = " + formatNumber(r.c_deg, 3) + " deg is outside the C travel of " + m_.file);
+            motion("C index", tip(), r.c_deg, note);
+            const double dt = rotaryTime(r.c_deg - c_, m_.c);
+            times_.rotary_index_s += dt;
+            t_ += dt;
+            c_ = r.c_deg;
+          },
+          [&](const gcode::RotateB& r) {
+            if (!m_.b.present) fail(note, "B move on a machine without a B axis (" + m_.file + ")");
+            if (!m_.b.continuous && (r.b_deg < m_.b.min_deg - 1e-9 || r.b_deg > m_.b.max_deg + 1e-9))
+              fail(note, "B = " + formatNumber(r.b_deg, 3) + " deg is outside the B travel of " + m_.file);
+            const double dt = rotaryTime(r.b_deg - b_, m_.b);
+            times_.rotary_index_s += dt;
+            t_ += dt;
+            b_ = r.b_deg;
+          },
+          [&](const gcode::ToolChange& tc) {
+            if (spindle_rpm_ != 0) fail(note, "tool change T" + std::to_string(tc.tool) + " with the spindle turning (M5 first)");
+            const WalkerTool& t = toolFor(tc.tool, note);
+            if (tc.apply_length_offset == (t.number == m_.tool_change.empty_tool))
+              fail(note, "T" + std::to_string(tc.tool) + (tc.apply_length_offset ? ": the empty spindle has no length offset (G49)"
+                                                                                   : ": a tool needs its length offset (G43)"));
+            times_.tool_change_s += m_.tool_change.time_s;
+            t_ += m_.tool_change.time_s;
+            tool_ = t;
+          },
+          [&](const gcode::Spindle& s) {
+            if (s.rpm < 0) fail(note, "a negative spindle speed");
+            if (s.rpm > 0 && !tool_.cutter)
+              fail(note, "spindle start with " + std::string(tool_.probe ? "the touch probe" : "no cutter") + " in the spindle");
+            spindle_rpm_ = s.rpm;
+          },
+          [&](const gcode::Coolant&) {},
+          [&](const gcode::Dwell& d) {
+            if (d.seconds < 0) fail(note, "a negative dwell");
+            times_.dwell_s += d.seconds;
+            t_ += d.seconds;
+          },
+          [&](const gcode::Feed& f) {
+            Vector3d to = tip();
+            if (f.x) to.x() = *f.x;
+            if (f.y) to.y() = *f.y;
+            if (f.z) to.z() = *f.z;
+            const Vector3d g = to + Vector3d(0, 0, L);
+            const double len = (g - gauge_).norm();
+            const double c_to = f.c ? *f.c : c_;
+            const double rot = std::fabs(c_to - c_);
+            if (len > 0 && rot > 0) fail(note, "a feed move of C together with X/Y/Z (not planned, not simulated)");
+            if (note.cut && !tool_.cutter) fail(note, "a cut without a cutter in the spindle");
+            if (note.cut && spindle_rpm_ == 0) fail(note, "a cut with the spindle stopped");
+            checkTravel(g, note, "feed move");
+            if (rot > 0) {
+              if (!m_.c.present) fail(note, "C move on a machine without a C axis (" + m_.file + ")");
+              const double turning = m_.c.max_turning_speed_rpm > 0 ? m_.c.max_turning_speed_rpm : m_.c.max_speed_rpm;
+              if (!(f.feed > 0)) fail(note, "a C feed move without a feed rate");
+              if (f.feed / 360.0 > turning + 1e-9)
+                fail(note, "C feed F" + formatNumber(f.feed, 3) + " deg/min = " + formatNumber(f.feed / 360.0, 3) +
+                               " rpm exceeds C's max_turning_speed " + formatNumber(turning, 3) + " rpm of " + m_.file);
+              motion("C feed move", to, c_to, note);
+              const double dt = rot / f.feed * 60.0;
+              times_.rotary_feed_s += dt;
+              t_ += dt;
+              c_ = c_to;
+            } else {
+              checkLinearFeed(f.feed, note, note.cut ? "cut" : "feed move");
+              motion(note.cut ? "cut" : "feed move", to, c_, note);
+              const double dt = len / f.feed * 60.0;
+              times_.feed_s += dt;
+              t_ += dt;
+            }
+            gauge_ = g;
+          },
+          [&](const gcode::ProtectedMove& pm) {
+            if (!tool_.probe) fail(note, "a protected probe move without the probe in the spindle");
+            if (spindle_rpm_ != 0) fail(note, "probing with the spindle turning");
+            const Vector3d to(pm.x, pm.y, pm.z), g = to + Vector3d(0, 0, L);
+            checkTravel(g, note, "protected move");
+            checkLinearFeed(pm.feed_mm_per_min, note, "protected move");
+            motion("protected move", to, c_, note);
+            const double dt = (g - gauge_).norm() / pm.feed_mm_per_min * 60.0;
+            times_.protected_s += dt;
+            t_ += dt;
+            gauge_ = g;
+          },
+          [&](const gcode::ProbeMove& pm) {
+            if (!tool_.probe) fail(note, "a probe move without the probe in the spindle");
+            if (spindle_rpm_ != 0) fail(note, "probing with the spindle turning");
+            if (note.point_index < 0) throw std::logic_error(note.where + ": a probe move without its planned contact");
+            const Vector3d to(pm.x, pm.y, pm.z), g = to + Vector3d(0, 0, L);
+            checkTravel(g, note, "probing move end (overtravel)");
+            checkLinearFeed(pm.feed_mm_per_min, note, "probing move");
+            motion("probe move", to, c_, note);
+            // Timed to the nominal contact, where the controller latches and stops.
+            const Vector3d gc = note.contact_mm + Vector3d(0, 0, L);
+            const double dt = (gc - gauge_).norm() / pm.feed_mm_per_min * 60.0;
+            times_.probing_s += dt;
+            t_ += dt;
+            gauge_ = gc;
+          },
+      },
+      op);
+}
+
+}  // namespace probeloop::planner

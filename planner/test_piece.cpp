@@ -1,0 +1,165 @@
+#include "planner/test_piece.hpp"
+
+#include <cstdio>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+#include "core/csv.hpp"
+#include "core/error.hpp"
+#include "planner/sphere_cycle.hpp"
+#include "planner/thermal_test_piece.hpp"
+
+namespace probeloop::planner {
+
+namespace {
+
+std::string join(const std::string& dir, const std::string& file) {
+  return (std::filesystem::path(dir) / file).string();
+}
+
+std::string printf1(const char* fmt, double v) {
+  char b[128];
+  std::snprintf(b, sizeof b, fmt, v);
+  return b;
+}
+
+std::string hms(double s) {
+  const long t = std::lround(s);
+  char b[32];
+  std::snprintf(b, sizeof b, "%ld:%02ld:%02ld", t / 3600, (t / 60) % 60, t % 60);
+  return b;
+}
+
+TestPiecePlan sphere(const parts::SphereArtifact& a, const parts::Machine& m, parts::Dialect dialect,
+                     const std::string& out_dir) {
+  PlanFiles files;
+  const bool linux = dialect == parts::Dialect::LinuxCnc;
+  files.program_file = linux ? "sphere_cycle.ngc" : "sphere_cycle.nc";
+  auto plan = planSphereCycle(a, m, files);
+  plan.manifest.dialect = parts::dialectName(dialect);
+  plan.manifest.programs.front().dialect = plan.manifest.dialect;
+  TestPiecePlan out;
+  PlannedProgram p;
+  p.role = "sphere_cycle";
+  p.file = files.program_file;
+  p.text = programText(plan, dialect);
+  const double T = plan.cycle_time.total();
+  p.duration_s = plan.manifest.cycles * T + (plan.manifest.cycles - 1) * plan.manifest.gap_s;
+  out.programs.push_back(p);
+  // The planner part of `probeloop plan`'s report (unchanged since the sphere cycle came).
+  std::ostringstream s;
+  const auto& t = plan.cycle_time;
+  char line[256];
+  std::snprintf(line, sizeof line, "Planned %d cycles of the sphere cycle for %s (%s dialect)\n", plan.manifest.cycles,
+                m.name.c_str(), parts::dialectName(dialect));
+  s << line;
+  s << "  wrote " << join(out_dir, files.program_file) << " and " << join(out_dir, "plan.json") << "\n";
+  s << printf1("Estimated cycle time %.1f s (seed 004: 95 s incl. two tool changes):\n", t.total());
+  s << printf1("  tool changes %6.1f s\n", t.tool_change_s) << printf1("  C indexing   %6.1f s\n", t.c_index_s)
+    << printf1("  rapids       %6.1f s\n", t.rapid_s) << printf1("  protected    %6.1f s\n", t.protected_s)
+    << printf1("  probing      %6.1f s\n", t.probing_s);
+  s << "  (no acceleration; see docs/sphere-cycle.md for the comparison with 95 s)\n";
+  out.summary = s.str();
+  out.manifest = std::move(plan.manifest);
+  return out;
+}
+
+TestPiecePlan thermal(const parts::ThermalTestPiece& t, const parts::Machine& m, parts::Dialect dialect,
+                      const std::string& out_dir) {
+  auto plan = planThermalTestPiece(t, m, dialect);
+  TestPiecePlan out;
+  for (std::size_t i = 0; i < plan.programs.size(); ++i) {
+    PlannedProgram p;
+    p.role = plan.programs[i].role;
+    p.file = plan.programs[i].file;
+    p.text = ttpProgramText(plan.programs[i], dialect);
+    p.start_s = plan.start_s[i];
+    p.duration_s = plan.duration_s[i];
+    out.programs.push_back(p);
+  }
+  const auto& man = plan.manifest;
+  out.files.emplace_back(man.ttp.cmm_plan, plan.cmm_points_csv);
+
+  std::ostringstream s;
+  s << "Planned the thermal test piece (seed 004 Ch. 7) for " << m.name << " (" << parts::dialectName(dialect)
+    << " dialect): three programs, run back to back\n";
+  const char* notes[3] = {"seed 004: about 15 min, L2018", t.wait_s == 3600 ? "seed 004: 8 h 5 min, L2043" : "", ""};
+  for (std::size_t i = 0; i < out.programs.size(); ++i) {
+    const auto& p = out.programs[i];
+    s << "  " << p.file << std::string(p.file.size() < 18 ? 18 - p.file.size() : 1, ' ')
+      << (dialect == parts::Dialect::FanucMacroB ? "O" + std::to_string(plan.programs[i].program.number) + "  " : std::string())
+      << "starts "
+      << hms(p.start_s) << ", runs " << hms(p.duration_s) << " (" << formatNumber(p.duration_s, 1) << " s)";
+    if (i == 1) {
+      s << ": " << plan.loads.size() << " waits of " << formatNumber(t.wait_s) << " s + " << man.cut_cycles.size()
+        << " cutting cycles of " << formatNumber(plan.cycle_s_min, 1) << "-" << formatNumber(plan.cycle_s_max, 1) << " s";
+    }
+    if (i == 2) s << ": " << man.points.size() << " probed points, log " << plan.programs[i].program.log_file;
+    if (notes[i][0]) s << " (" << notes[i] << ")";
+    s << "\n";
+    const auto& w = plan.times[i];
+    const std::pair<const char*, double> parts[] = {
+        {"feeds", w.feed_s},         {"C turned by feed", w.rotary_feed_s}, {"rapids", w.rapid_s},
+        {"indexing", w.rotary_index_s}, {"tool changes", w.tool_change_s},  {"protected moves", w.protected_s},
+        {"probing", w.probing_s},    {"dwells", w.dwell_s}};
+    std::string sep = "    ";
+    for (const auto& [name, v] : parts)
+      if (v > 0.05) {
+        s << sep << name << " " << formatNumber(v, 1) << " s";
+        sep = ", ";
+      }
+    s << "\n";
+  }
+  const int surfaces = t.z_paths + 4 * t.facets_per_segment;
+  s << surfaces << " measurement surfaces: " << t.z_paths << " Z paths (" << formatNumber(t.z_path_pitch_mm) << " mm pitch) + "
+    << 4 * t.facets_per_segment << " facets (4 x " << t.facets_per_segment << ", " << formatNumber(t.facet_pitch_deg)
+    << " deg pitch), " << formatNumber(t.cut_depth_mm) << " mm deep; cycle 0 cuts the references (Z path " << t.order.front()
+    << ", facets " << t.order.front() << ")\n";
+  for (const auto& ph : t.load) {
+    s << "Load " << ph.name << ": " << ph.cycles << " x " << formatNumber(t.wait_s) << " s";
+    const TtpLoad* l = nullptr;
+    for (const auto& x : plan.loads)
+      if (x.phase == ph.name) l = &x;
+    if (l && l->rpm > 0) {
+      s << ", C at " << formatNumber(l->rpm) << " rpm (" << l->pairs << " x " << l->turns_per_move
+        << " turns forward and back"
+        << (l->dwell_s > 0 ? ", then " + formatNumber(l->dwell_s, 3) + " s dwell" : std::string()) << ")";
+      if (l->rpm < l->requested_rpm)
+        s << " - " << formatNumber(l->requested_rpm) << " rpm asked, capped at C's max_turning_speed of " << m.file;
+    } else {
+      s << ", NC hold at C 0 (dwell)";
+    }
+    s << "\n";
+  }
+  s << "Test: Z set once, tool tip at Z " << formatNumber(plan.test_cutting_z_mm, 4) << " (part z " << formatNumber(t.cuttingZ())
+    << ") from the first cut to the last\n";
+  std::map<std::string, int> per;
+  for (const auto& p : man.points) ++per[p.feature];
+  s << "Inspection: " << man.points.size() << " points (TOP " << per["TOP"] << ", FLANK_P " << per["FLANK_P"] << ", FLANK_N "
+    << per["FLANK_N"] << ", CYL " << per["CYL"] << ", " << t.z_paths << " Z paths x " << per[parts::zPathId(1)] << ", "
+    << 4 * t.facets_per_segment << " facets x " << per[parts::facetId(parts::FacetSide::X1, 1)]
+    << "); the CMM measures the same points (" << man.ttp.cmm_plan << ")\n";
+  s << "  wrote";
+  for (const auto& p : out.programs) s << " " << join(out_dir, p.file) << ",";
+  s << " " << join(out_dir, man.ttp.cmm_plan) << " and " << join(out_dir, "plan.json") << "\n";
+  s << "  (planned with the simulator's clock, no acceleration: docs/simulator.md §2, docs/thermal-test-piece.md §5)\n";
+  out.summary = s.str();
+  out.manifest = std::move(plan.manifest);
+  return out;
+}
+
+}  // namespace
+
+TestPiecePlan planTestPiece(const parts::TestPiece& piece, const parts::Machine& machine, parts::Dialect dialect,
+                            const std::string& out_dir) {
+  if (const auto* a = piece.sphereArtifact()) return sphere(*a, machine, dialect, out_dir);
+  if (const auto* t = piece.thermalTestPiece()) return thermal(*t, machine, dialect, out_dir);
+  if (piece.kind == "workpiece")
+    throw InputError(piece.file, 0,
+                     "a plain workpiece has no planner: write its program yourself and run it with probeloop simulate");
+  throw InputError(piece.file, 0, "kind: '" + piece.kind + "' has no planner");
+}
+
+}  // namespace probeloop::planner

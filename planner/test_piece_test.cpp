@@ -1,0 +1,83 @@
+// The kind dispatch every `probeloop plan` goes through (planner/test_piece.hpp).
+#include "planner/test_piece.hpp"
+
+#include <gtest/gtest.h>
+
+#include "core/error.hpp"
+#include "planner/sphere_cycle.hpp"
+
+using namespace probeloop;
+using namespace probeloop::planner;
+
+namespace {
+const std::string src = PROBELOOP_SOURCE_DIR;
+parts::Machine machine(const std::string& name) { return parts::loadMachine(src + "/parts/machines/" + name + ".yaml"); }
+}  // namespace
+
+TEST(PlanTestPiece, TheSphereArtifactIsPlannedByTheSphereCycleByteForByte) {
+  const auto piece = parts::loadTestPiece(src + "/parts/sphere_artifact.yaml");
+  const auto artifact = parts::loadSphereArtifact(src + "/parts/sphere_artifact.yaml");
+  for (const char* name : {"nmv5000", "linuxcnc_rotary_mill"})
+    for (auto d : {parts::Dialect::LinuxCnc, parts::Dialect::FanucMacroB}) {
+      const auto m = machine(name);
+      const auto plan = planTestPiece(piece, m, d, "out");
+      PlanFiles files;
+      files.program_file = d == parts::Dialect::LinuxCnc ? "sphere_cycle.ngc" : "sphere_cycle.nc";
+      auto ref = planSphereCycle(artifact, m, files);
+      ref.manifest.dialect = parts::dialectName(d);
+      ref.manifest.programs.front().dialect = ref.manifest.dialect;
+      ASSERT_EQ(plan.programs.size(), 1u);
+      EXPECT_EQ(plan.programs[0].file, files.program_file);
+      EXPECT_EQ(plan.programs[0].text, programText(ref, d));
+      EXPECT_EQ(parts::manifestToJson(plan.manifest), parts::manifestToJson(ref.manifest));
+      EXPECT_TRUE(plan.files.empty());
+      EXPECT_EQ(plan.summary.rfind("Planned " + std::to_string(ref.manifest.cycles) + " cycles of the sphere cycle for " + m.name, 0), 0u);
+      EXPECT_NE(plan.summary.find("  wrote out/" + files.program_file + " and out/plan.json\n"), std::string::npos) << plan.summary;
+      const std::string tail = "  (no acceleration; see docs/sphere-cycle.md for the comparison with 95 s)\n";
+      EXPECT_EQ(plan.summary.substr(plan.summary.size() - tail.size()), tail);
+      EXPECT_NEAR(plan.programs[0].duration_s,
+                  ref.manifest.cycles * ref.cycle_time.total() + (ref.manifest.cycles - 1) * ref.manifest.gap_s, 1e-9);
+    }
+}
+
+TEST(PlanTestPiece, APlainWorkpieceHasNoPlanner) {
+  const auto piece = parts::loadTestPiece(src + "/examples/workpiece_block.yaml");
+  try {
+    planTestPiece(piece, machine("vmc3"), parts::Dialect::LinuxCnc);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("workpiece_block.yaml: a plain workpiece has no planner: write its program yourself and "
+                                         "run it with probeloop simulate"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(PlanTestPiece, TheThermalTestPieceGivesThreeProgramsTheCmmPlanAndASummary) {
+  const auto piece = parts::loadTestPiece(src + "/parts/thermal_test_piece.yaml");
+  const auto plan = planTestPiece(piece, machine("nmv5000"), parts::Dialect::FanucMacroB, "plan");
+  ASSERT_EQ(plan.programs.size(), 3u);
+  const char* files[3] = {"pre_machining.nc", "thermal_test.nc", "inspection.nc"};
+  const char* roles[3] = {"pre_machining", "test", "inspection"};
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(plan.programs[i].file, files[i]);
+    EXPECT_EQ(plan.programs[i].role, roles[i]);
+    EXPECT_EQ(plan.programs[i].text.rfind("%\nO" + std::to_string(2001 + i) + " (", 0), 0u);
+    EXPECT_EQ(plan.manifest.programs[i].file, files[i]);
+    EXPECT_NEAR(plan.manifest.programs[i].start_s, plan.programs[i].start_s, 1e-12);
+  }
+  EXPECT_EQ(plan.manifest.programs[2].log_file, "ttp_probe.log");
+  EXPECT_EQ(plan.manifest.programs[0].log_file, "");
+  ASSERT_EQ(plan.files.size(), 1u);
+  EXPECT_EQ(plan.files[0].first, "cmm_points.csv");
+  EXPECT_NE(plan.files[0].second.find("feature,point,x_mm,y_mm,z_mm,nx,ny,nz\nTOP,1,"), std::string::npos);
+  for (const char* s : {"45 measurement surfaces: 9 Z paths (12 mm pitch) + 36 facets (4 x 9, 6 deg pitch)",
+                        "8 waits of 3600 s + 9 cutting cycles", "Inspection: 364 points", "plan/cmm_points.csv and plan/plan.json",
+                        "C at 1200 rpm (180 x 200 turns forward and back)"})
+    EXPECT_NE(plan.summary.find(s), std::string::npos) << s << "\n" << plan.summary;
+  // The LinuxCNC dialect of the same machine: .ngc files, the inspection log opened by name.
+  const auto lc = planTestPiece(piece, machine("nmv5000"), parts::Dialect::LinuxCnc);
+  EXPECT_EQ(lc.programs[2].file, "inspection.ngc");
+  EXPECT_NE(lc.programs[2].text.find("(LOGOPEN,ttp_probe.log)\n#<_pl_cycle> = 1\n"), std::string::npos);
+  EXPECT_EQ(lc.manifest.dialect, "linuxcnc");
+}
