@@ -81,37 +81,33 @@ int cmdSynth(const std::string& manifest_file, const std::string& truth_file,
   return 0;
 }
 
-int cmdSimulate(const std::string& program_file, const std::string& machine_file,
+int cmdSimulate(const std::vector<std::string>& program_files, const std::string& machine_file,
                 const std::string& part_file, const std::string& truth_file, const std::string& out_dir,
                 std::uint64_t seed, const std::string& cmm_file, bool trace) {
   const auto machine = parts::loadMachine(machine_file);
   const auto truth = sim::loadMachineTruth(truth_file);
-  const std::string kind = parts::partKind(part_file);
-  std::optional<parts::SphereArtifact> artifact;
-  std::optional<parts::Workpiece> workpiece;
+  const auto piece = parts::loadTestPiece(part_file);
   sim::SimulationPart part;
-  if (kind == "sphere_artifact") {
-    artifact = parts::loadSphereArtifact(part_file);
-    part.artifact = &*artifact;
-  } else if (kind == "workpiece") {
-    workpiece = parts::loadWorkpiece(part_file);
-    part.workpiece = &*workpiece;
-  } else {
-    throw InputError(part_file, 1, "kind: '" + kind + "' cannot stand on the simulated table (sphere_artifact or workpiece)");
-  }
+  part.test_piece = &piece;
   if (!cmm_file.empty()) {
     part.cmm_points = sim::readCmmPoints(cmm_file);
     part.cmm_points_file = cmm_file;
   }
   part.trace = trace;
-  const auto s = sim::simulateProgram(program_file, readFile(program_file), machine, part, truth, seed);
-  const std::string log_file = fs::path(s.log_name).filename().string();
-  writeFileAtomic(join(out_dir, log_file), s.log_text);
+  std::vector<sim::ProgramSource> programs;
+  for (const auto& f : program_files) programs.push_back({f, readFile(f)});
+  const auto s = sim::simulatePrograms(programs, machine, part, truth, seed);
+  std::string written;
+  for (const auto& l : s.logs) {
+    const std::string name = fs::path(l.name).filename().string();
+    writeFileAtomic(join(out_dir, name), l.text);
+    written += name + " (controller log), ";
+  }
   writeFileAtomic(join(out_dir, "points.csv"), s.points_csv);
   writeFileAtomic(join(out_dir, "inputs.csv"), s.inputs_csv);
   writeFileAtomic(join(out_dir, "truth.json"), s.truth_json);
   std::string extra;
-  if (workpiece) {
+  if (!piece.sphereArtifact()) {
     writeFileAtomic(join(out_dir, "cuts.json"), s.cuts_json);
     extra += ", cuts.json";
   }
@@ -123,11 +119,10 @@ int cmdSimulate(const std::string& program_file, const std::string& machine_file
     writeFileAtomic(join(out_dir, "cmm_export.csv"), s.cmm_csv);
     extra += ", cmm_export.csv";
   }
-  std::printf("Simulated %s on %s (seed %llu): %ld blocks, %ld probe events, %.1f h of machine time\n",
-              program_file.c_str(), machine.name.c_str(), static_cast<unsigned long long>(seed), s.blocks,
-              s.probe_events, s.end_time_s / 3600.0);
-  std::printf("  wrote %s (controller log), points.csv, inputs.csv, truth.json%s in %s\n", log_file.c_str(),
-              extra.c_str(), out_dir.c_str());
+  const std::string what = program_files.size() == 1 ? program_files.front() : std::to_string(program_files.size()) + " programs";
+  std::printf("Simulated %s on %s (seed %llu): %ld blocks, %ld probe events, %.1f h of machine time\n", what.c_str(),
+              machine.name.c_str(), static_cast<unsigned long long>(seed), s.blocks, s.probe_events, s.end_time_s / 3600.0);
+  std::printf("  wrote %spoints.csv, inputs.csv, truth.json%s in %s\n", written.c_str(), extra.c_str(), out_dir.c_str());
   return 0;
 }
 
@@ -262,17 +257,19 @@ int main(int argc, char** argv) {
   syn->add_option("--out", out, "output folder")->capture_default_str();
   syn->add_option("--seed", seed, "random seed")->capture_default_str();
 
-  std::string program, part;
-  auto* simc = app.add_subcommand("simulate", "Run an emitted program on a virtual machine with known error effects");
-  simc->add_option("program", program, "G-code program (.ngc LinuxCNC, .nc Fanuc macro B)")->required()->check(CLI::ExistingFile);
+  std::vector<std::string> sim_programs;
+  std::string part;
+  auto* simc = app.add_subcommand("simulate", "Run emitted programs, one after the other, on a virtual machine with known error effects");
+  simc->add_option("programs", sim_programs, "G-code programs (.ngc LinuxCNC, .nc Fanuc macro B), run back to back")
+      ->required()->check(CLI::ExistingFile);
   simc->add_option("--machine", machine, "machine description (YAML)")->required()->check(CLI::ExistingFile);
   std::string cmm_points;
   bool sim_trace = false;
-  simc->add_option("--part", part, "what stands on the table: a sphere artifact or a workpiece (YAML)")->required()->check(CLI::ExistingFile);
+  simc->add_option("--part", part, "what stands on the table: a sphere artifact, a thermal test piece or a workpiece (YAML)")->required()->check(CLI::ExistingFile);
   simc->add_option("--truth", truth, "the machine's error effects (YAML, kind: machine_truth)")->required()->check(CLI::ExistingFile);
   simc->add_option("--out", out, "output folder")->capture_default_str();
   simc->add_option("--seed", seed, "random seed")->capture_default_str();
-  simc->add_option("--cmm-points", cmm_points, "workpiece: CMM points to measure after the program "
+  simc->add_option("--cmm-points", cmm_points, "machined part: CMM points to measure after the programs "
                    "(feature,point,x_mm,y_mm,z_mm,nx,ny,nz)")->check(CLI::ExistingFile);
   simc->add_flag("--trace", sim_trace, "also write trace.csv: every motion, dwell and tool change with its time and line");
 
@@ -335,7 +332,7 @@ int main(int argc, char** argv) {
     if (*plan) return cmdPlan(artifact, machine, out, dialect);
     if (*res) return cmdResolution(artifact, machine, step_um);
     if (*syn) return cmdSynth(manifest, truth, out, seed);
-    if (*simc) return cmdSimulate(program, machine, part, truth, out, seed, cmm_points, sim_trace);
+    if (*simc) return cmdSimulate(sim_programs, machine, part, truth, out, seed, cmm_points, sim_trace);
     if (*fit) return cmdFit(fa);
     if (*gum) return cmdGum(gum_model, gum_mcm || gum_trials > 0, gum_trials, seed, gum_digits, gum_json);
     if (*ev) return cmdEvaluate(points, manifest, out, format, free_radius, scene, exaggeration, compare_with);

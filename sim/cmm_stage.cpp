@@ -8,6 +8,7 @@
 #include "core/csv.hpp"
 #include "core/error.hpp"
 #include "sim/material_removal.hpp"
+#include "sim/random_streams.hpp"
 
 namespace probeloop::sim {
 
@@ -38,12 +39,26 @@ std::vector<CmmPoint> readCmmPoints(const std::string& path) {
 }
 
 std::string measureOnCmm(const Stock& stock, const parts::Workpiece& w, const std::vector<CmmPoint>& points,
-                         const std::string& file, std::uint64_t seed, double search) {
+                         const std::string& file, std::uint64_t seed, double search, double alpha_per_K) {
   std::mt19937_64 rng(seed ^ 0xC3A5C85C97CB3127ULL);
   std::normal_distribution<double> normal(0.0, 1.0);
+  const double half_K = w.cmm.temperature_half_width_K;
+  double dT_K = 0;
+  if (half_K > 0) {
+    std::mt19937_64 room(streamSeed(seed, 7));
+    dT_K = std::uniform_real_distribution<double>(-half_K, half_K)(room);
+  }
+  const double alpha = std::isnan(alpha_per_K) ? w.material.alpha_per_K : alpha_per_K;
+  const double scale = 1.0 + alpha * dT_K;  // the part as it is in the room, uncorrected
+  const std::string mpe = " um" + (w.cmm.mpe_length_mm > 0 ? " + L/" + formatNumber(w.cmm.mpe_length_mm) : std::string());
   std::ostringstream o;
-  o << "# probeloop simulate: CMM export, workpiece frame at 20 C; MPE = " << formatNumber(w.cmm.mpe_constant_um)
-    << " um" << (w.cmm.mpe_length_mm > 0 ? " + L/" + formatNumber(w.cmm.mpe_length_mm) : std::string()) << "\n";
+  if (half_K > 0)
+    o << "# probeloop simulate: CMM export, part frame; the part at 20 C + dT, dT = " << formatNumber(dT_K, 6)
+      << " K (drawn within +-" << formatNumber(half_K) << " K; the expansion alpha dT about the datum is not corrected, "
+      << "seed 004 Eq. 7.6); MPE = " << formatNumber(w.cmm.mpe_constant_um) << mpe << "\n";
+  else
+    o << "# probeloop simulate: CMM export, workpiece frame at 20 C; MPE = " << formatNumber(w.cmm.mpe_constant_um) << mpe
+      << "\n";
   o << "feature,point,x_mm,y_mm,z_mm,nx,ny,nz\n";
   for (const auto& p : points) {
     const Eigen::Vector3d from = p.nominal_mm + search * p.normal;
@@ -56,7 +71,9 @@ std::string measureOnCmm(const Stock& stock, const parts::Workpiece& w, const st
                                          ": no surface within " + formatNumber(search) + " mm of the nominal point along the normal");
     const double L = (p.nominal_mm - w.datum()).norm();
     const double mpe_um = w.cmm.mpe_constant_um + (w.cmm.mpe_length_mm > 0 ? L / w.cmm.mpe_length_mm : 0.0);
-    const Eigen::Vector3d m = from - *s * p.normal + (mpe_um / 2) * 1e-3 * normal(rng) * p.normal;
+    Eigen::Vector3d surface = from - *s * p.normal;
+    if (half_K > 0) surface = w.datum() + scale * (surface - w.datum());
+    const Eigen::Vector3d m = surface + (mpe_um / 2) * 1e-3 * normal(rng) * p.normal;
     o << p.feature << "," << p.point << "," << formatNumber(m.x(), 4) << "," << formatNumber(m.y(), 4) << ","
       << formatNumber(m.z(), 4) << "," << formatNumber(p.normal.x(), 6) << "," << formatNumber(p.normal.y(), 6) << ","
       << formatNumber(p.normal.z(), 6) << "\n";

@@ -7,9 +7,16 @@
 // naming the point when no surface lies within ±search_mm of the nominal point. Noise:
 // normal along the normal with sigma = MPE(L)/2, MPE = A + L/K, L the point's distance from
 // the workpiece datum (a length-dependent per-point model); reported to 0.1 um.
+// The room: with cmm.temperature_half_width_K > 0 the part's temperature offset dT is drawn
+// uniformly within +-half width (seeded, its own stream, sim/random_streams.hpp), and every
+// measured point is scaled about the datum by 1 + alpha dT: a CMM that does not correct the
+// part's expansion (the evaluation's budget carries it as seed 004 Eq. 7.6). The drawn dT is
+// printed in the export's comment line; with half width 0 nothing is drawn and the export
+// is what it always was.
 #pragma once
 #include <Eigen/Dense>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -29,7 +36,9 @@ struct CmmPoint {
 
 std::vector<CmmPoint> readCmmPoints(const std::string& path);
 
+// alpha_per_K: the part's real expansion coefficient (NaN: the workpiece material's).
 std::string measureOnCmm(const Stock& stock, const parts::Workpiece& w, const std::vector<CmmPoint>& points,
-                         const std::string& points_file, std::uint64_t seed, double search_mm = 5.0);
+                         const std::string& points_file, std::uint64_t seed, double search_mm = 5.0,
+                         double alpha_per_K = std::numeric_limits<double>::quiet_NaN());
 
 }  // namespace probeloop::sim

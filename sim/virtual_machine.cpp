@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <optional>
 #include <nlohmann/json.hpp>
 #include <random>
@@ -16,6 +17,8 @@
 #include "gcode/probe_log.hpp"
 #include "model/effects.hpp"
 #include "sim/material_removal.hpp"
+#include "sim/random_streams.hpp"
+#include "sim/test_piece_truth.hpp"
 
 namespace probeloop::sim {
 
@@ -23,15 +26,6 @@ using Eigen::Vector3d;
 using gcode::MachinePosition;
 
 namespace {
-
-// Independent random streams per effect, so switching one effect on does not reshuffle
-// the draws of another (splitmix64 of seed and stream number).
-std::uint64_t streamSeed(std::uint64_t seed, std::uint64_t stream) {
-  std::uint64_t z = seed * 0x9E3779B97F4A7C15ULL + stream * 0xBF58476D1CE4E5B9ULL + 0x94D049BB133111EBULL;
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
-  return z ^ (z >> 31);
-}
 
 double poly(const std::vector<double>& c, double x) {
   double v = 0;
@@ -63,8 +57,22 @@ double segmentDistance(const Vector3d& p0, const Vector3d& p1, const Vector3d& q
   return ((p0 + s * d1) - (q0 + t * d2)).norm();
 }
 
+// Closest distance from point p to the arc of radius rho about c from angle lo over span
+// (counterclockwise, rad), 2D.
+double arcDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& c, double rho, double lo, double span) {
+  const Eigen::Vector2d w = p - c;
+  if (span >= 2 * kPi - 1e-12) return std::fabs(w.norm() - rho);
+  double ang = std::atan2(w.y(), w.x()) - lo;
+  ang -= 2 * kPi * std::floor(ang / (2 * kPi));
+  if (ang <= span) return std::fabs(w.norm() - rho);
+  const Eigen::Vector2d e0 = c + rho * Eigen::Vector2d(std::cos(lo), std::sin(lo));
+  const Eigen::Vector2d e1 = c + rho * Eigen::Vector2d(std::cos(lo + span), std::sin(lo + span));
+  return std::min((p - e0).norm(), (p - e1).norm());
+}
+
 struct ProbeEvent {
   double time_s = 0;
+  int log_stream = -1;  // which log of the run (index)
   long log_line = 0;  // 1-based line of the log written after this probe (0 = none)
   double c_deg = 0;
   Vector3d approach = Vector3d::Zero();
@@ -96,7 +104,10 @@ class VirtualMachine : public gcode::MachineInterface {
     inputs_ << "time_s";
     for (const auto& s : tr.thermal.sensors) inputs_ << "," << s.column;
     inputs_ << ",c_rpm,spindle_rpm,feed_mm_per_min,mwf_on,tool_changes\n";
-    if (w_) stock_ = Stock(w_->stock_min_mm, w_->stock_max_mm);
+    if (w_) {
+      stock_ = Stock(w_->stock_min_mm, w_->stock_max_mm, 0.25, w_->cylindrical);
+      for (const auto& h : w_->holes) stock_.addHole(h.centre_mm, h.radius_mm, h.z_min_mm, h.z_max_mm);
+    }
     if (tr.duty.tool_changes_per_hour > 0) next_duty_change_ = drawDutyGap();
     // At rest at the top of Z (the tool-change height region), X and Y at the C axis.
     pos_.xyz_mm = Vector3d(std::clamp(m_.c_axis_centre_mm.x(), m_.x.min_mm, m_.x.max_mm),
@@ -124,7 +135,11 @@ class VirtualMachine : public gcode::MachineInterface {
 
   void feed(const MachinePosition& to, double F) override {
     checkTravel(to);
-    checkFeed(F);
+    // A move of rotary axes alone reads F in deg/min (LinuxCNC and Fanuc): the axis turns at
+    // F / 360 rpm, limited by its turning speed, not by the XYZ feed.
+    const bool rotary_only = to.xyz_mm == pos_.xyz_mm && (to.c_deg != pos_.c_deg || to.b_deg != pos_.b_deg);
+    if (rotary_only) checkRotaryFeed(to, F);
+    else checkFeed(F);
     if (w_ && isCutter() && spindle_rpm_ != 0) {
       cutMove(to, F);
       return;
@@ -133,9 +148,20 @@ class VirtualMachine : public gcode::MachineInterface {
     const double len = (to.xyz_mm - pos_.xyz_mm).norm();
     const double rot = std::max(std::fabs(to.c_deg - pos_.c_deg), std::fabs(to.b_deg - pos_.b_deg));
     const double t0 = t_;
-    move((len > 0 ? len : rot) / F * 60.0, len > 0 ? F : 0.0);
+    const double dt = (len > 0 ? len : rot) / F * 60.0;
+    c_move_rpm_ = cMoveRpm(to, dt);
+    move(dt, len > 0 ? F : 0.0);
+    c_move_rpm_ = 0;
     traceRow("feed", to, F, t0);
     pos_ = to;
+  }
+
+  // The C axis's real speed during a feed move that turns it (a heat input, and the inputs
+  // CSV's c_rpm). Rapid indexing (G0 C) at the positioning speed lasts < 1 s per quarter
+  // turn and is left out, so the sphere campaigns' outputs stay as they were.
+  double cMoveRpm(const MachinePosition& to, double dt_s) const {
+    if (!(dt_s > 0) || to.c_deg == pos_.c_deg) return 0;
+    return std::fabs(to.c_deg - pos_.c_deg) / 360.0 / (dt_s / 60.0);
   }
 
   gcode::ProbeOutcome probe(const MachinePosition& to, double F, gcode::ProbeMode mode) override {
@@ -262,23 +288,79 @@ class VirtualMachine : public gcode::MachineInterface {
     spindle_rpm_ = rpm;
   }
   void coolant(bool on) override { coolant_ = on; }
-  void openLog(const std::string& name) override { log_name_ = name; }
+  // Fanuc: every program's DPRNT goes to the one dprnt.txt (POPEN names no file). LinuxCNC:
+  // the program's LOGOPEN file; a later LOGOPEN in the same program renames it (the last
+  // name wins, as before); a name an earlier program of the run wrote is refused, because
+  // LinuxCNC would overwrite that log.
+  void openLog(const std::string& name) override {
+    if (program_fanuc_) {
+      streamFor("dprnt.txt");
+      return;
+    }
+    for (std::size_t i = 0; i < logs_.size(); ++i)
+      if (logs_[i]->name == name && logs_[i]->program != program_index_)
+        throw InputError("", 0, "LOGOPEN," + name + ": an earlier program of this run (" + logs_[i]->program_file +
+                                    ") wrote this log, and LinuxCNC would overwrite it; give each program its own log name");
+    if (cur_log_ < 0) cur_log_ = newStream(name);
+    else logs_[static_cast<std::size_t>(cur_log_)]->name = name;
+  }
   void log(const std::string& line) override {
-    log_ << line << "\n";
-    ++log_lines_;
+    if (cur_log_ < 0) {
+      if (program_fanuc_) streamFor("dprnt.txt");
+      else cur_log_ = newStream("");
+    }
+    LogStream& l = *logs_[static_cast<std::size_t>(cur_log_)];
+    l.text << line << "\n";
+    ++l.lines;
     if (pending_ >= 0) {
-      events_[static_cast<std::size_t>(pending_)].log_line = log_lines_;
+      events_[static_cast<std::size_t>(pending_)].log_stream = cur_log_;
+      events_[static_cast<std::size_t>(pending_)].log_line = l.lines;
       pending_ = -1;
     }
   }
   void closeLog() override {}
 
+  // --- programs -------------------------------------------------------------------------
+  // A new program on the same machine. Its interpreter starts afresh (modal state, work
+  // offsets); the machine keeps its clock, state, stock, tool and position. The previous
+  // program's M2/M30 stopped the spindle and the coolant.
+  void beginProgram(const std::string& file, bool fanuc) {
+    if (program_index_ >= 0) {
+      spindle_rpm_ = 0;
+      coolant_ = false;
+    }
+    ++program_index_;
+    program_file_ = file;
+    program_fanuc_ = fanuc;
+    cur_log_ = -1;
+    if (fanuc)
+      for (std::size_t i = 0; i < logs_.size(); ++i)
+        if (logs_[i]->name == "dprnt.txt" && logs_[i]->fanuc) cur_log_ = static_cast<int>(i);
+  }
+  // A LinuxCNC log that was never named (not expected: the interpreter logs only after
+  // LOGOPEN) is the controller's log.
+  void endProgram() {
+    for (auto& l : logs_)
+      if (l->name.empty()) l->name = "controller.log";
+  }
+  // One program that wrote no log still has one (empty), as before.
+  void ensureLog(bool fanuc) {
+    if (logs_.empty()) {
+      program_fanuc_ = fanuc;
+      if (fanuc) streamFor("dprnt.txt");
+      else newStream("controller.log");
+    }
+  }
+
   // --- results --------------------------------------------------------------------------
   double time() const { return t_; }
-  std::string logText() const { return log_.str(); }
+  std::vector<LogOutput> logs() const {
+    std::vector<LogOutput> out;
+    for (const auto& l : logs_) out.push_back({l->name, l->text.str()});
+    return out;
+  }
   std::string inputsText() const { return inputs_.str(); }
   const std::vector<ProbeEvent>& events() const { return events_; }
-  const std::string& logName() const { return log_name_; }
   void finish() {
     // A last sample at the end time, if the regular grid missed it.
     if (last_sample_t_ < t_ - 1e-9) sample();
@@ -290,6 +372,9 @@ class VirtualMachine : public gcode::MachineInterface {
   const parts::Workpiece* w_;
   Stock stock_;
   nlohmann::ordered_json cuts_ = nlohmann::ordered_json::array();
+  std::vector<CutState> cut_states_;  // parallel to cuts_: the machine when each cut started
+  long motions_ = 0;                  // motions, dwells and tool changes so far
+  long air_run_motion_ = -1;          // motions_ after the last cutting move in the air
   const MachineTruth& tr_;
   std::mt19937_64 noise_rng_, atc_rng_, sensor_rng_, duty_rng_;
   // One normal distribution per stream: std::normal_distribution keeps the second value of
@@ -307,6 +392,7 @@ class VirtualMachine : public gcode::MachineInterface {
   Vector3d atc_um_ = Vector3d::Zero();
   double spindle_rpm_ = 0;
   double path_speed_mm_per_min_ = 0;
+  double c_move_rpm_ = 0;  // C speed while a feed move turns it
   bool coolant_ = false, dwelling_ = false;
   int tool_changes_ = 0;
   std::vector<double> duty_levels_;  // random C levels per hold period, drawn as needed
@@ -315,12 +401,44 @@ class VirtualMachine : public gcode::MachineInterface {
   double next_duty_change_ = -1;                // dwell-clock time of the next one (-1 = none)
   double settling_ = 0;                         // sum of the decaying unit jumps of the changes
   nlohmann::ordered_json tool_change_log_ = nlohmann::ordered_json::array();
-  std::ostringstream log_, inputs_;
-  long log_lines_ = 0, pending_ = -1;
-  std::string log_name_;
+  std::ostringstream inputs_;
+  long pending_ = -1;
+  struct LogStream {
+    std::string name;
+    bool fanuc = false;
+    int program = 0;
+    std::string program_file;
+    std::ostringstream text;
+    long lines = 0;
+  };
+  std::vector<std::unique_ptr<LogStream>> logs_;
+  int cur_log_ = -1;
+  int program_index_ = -1;
+  std::string program_file_;
+  bool program_fanuc_ = false;
+  int newStream(const std::string& name) {
+    auto l = std::make_unique<LogStream>();
+    l->name = name;
+    l->fanuc = program_fanuc_;
+    l->program = program_index_;
+    l->program_file = program_file_;
+    logs_.push_back(std::move(l));
+    return static_cast<int>(logs_.size()) - 1;
+  }
+  void streamFor(const std::string& name) {
+    for (std::size_t i = 0; i < logs_.size(); ++i)
+      if (logs_[i]->name == name) {
+        if (!logs_[i]->fanuc)
+          throw InputError("", 0, "POPEN: " + logs_[i]->program_file + " wrote a log named " + name +
+                                      ", where this run's DPRNT output goes; give that log another name");
+        cur_log_ = static_cast<int>(i);
+        return;
+      }
+    cur_log_ = newStream(name);
+  }
   std::vector<ProbeEvent> events_;
   int line_ = 0;
-  bool trace_on_ = false;
+  bool trace_on_ = false, trace_program_ = false;
   std::ostringstream trace_;
 
   struct Artifact {
@@ -340,6 +458,7 @@ class VirtualMachine : public gcode::MachineInterface {
   }
 
   double cRpm(double t) {
+    if (c_move_rpm_ > 0) return c_move_rpm_;  // a feed move turns C (the test's load)
     if (!dwelling_) return 0;
     const auto& d = tr_.duty;
     if (!d.c_profile.empty()) {
@@ -381,11 +500,14 @@ class VirtualMachine : public gcode::MachineInterface {
 
   // One row of the motion trace: what the controller commanded, when, from which line.
   void traceRow(const char* kind, const MachinePosition& to, double feed, double t_start) {
+    ++motions_;  // every motion, dwell and tool change ends here
     if (!trace_on_) return;
     trace_ << formatNumber(t_start, 3) << "," << formatNumber(t_ - t_start, 3) << "," << line_ << "," << kind << ","
            << formatNumber(to.xyz_mm.x(), 6) << "," << formatNumber(to.xyz_mm.y(), 6) << ","
            << formatNumber(to.xyz_mm.z(), 6) << "," << formatNumber(to.b_deg, 6) << "," << formatNumber(to.c_deg, 6)
-           << "," << formatNumber(feed, 3) << "," << tool_ << "\n";
+           << "," << formatNumber(feed, 3) << "," << tool_;
+    if (trace_program_) trace_ << "," << std::filesystem::path(program_file_).filename().string();
+    trace_ << "\n";
   }
 
   // Time passes while X/Y/Z move at this path speed (a heat input, and a column of the
@@ -610,6 +732,19 @@ class VirtualMachine : public gcode::MachineInterface {
       throw SafetyError("feed F" + formatNumber(F) + " exceeds the machine's maximum feed " + formatNumber(fmax) + " mm/min");
   }
 
+  void checkRotaryFeed(const MachinePosition& to, double F_deg_per_min) const {
+    const double rpm = F_deg_per_min / 360.0;
+    auto check = [&](const parts::RotaryAxis& ax, const char* name, double delta) {
+      if (delta == 0) return;
+      const double limit = ax.max_turning_speed_rpm > 0 ? ax.max_turning_speed_rpm : ax.max_speed_rpm;
+      if (rpm > limit + 1e-9)
+        throw SafetyError(std::string("rotary feed F") + formatNumber(F_deg_per_min) + " deg/min (" + formatNumber(rpm) +
+                          " rpm) exceeds the " + name + " axis's maximum turning speed " + formatNumber(limit) + " rpm");
+    };
+    check(m_.c, "C", to.c_deg - pos_.c_deg);
+    check(m_.b, "B", to.b_deg - pos_.b_deg);
+  }
+
   void checkTravel(const MachinePosition& to) const {
     const parts::LinearAxis* ax[] = {&m_.x, &m_.y, &m_.z};
     const char* names[] = {"X", "Y", "Z"};
@@ -637,10 +772,13 @@ class VirtualMachine : public gcode::MachineInterface {
 
 
   // --- the workpiece --------------------------------------------------------------------
-  // Machine coordinates of a point (tip coordinates) -> the workpiece frame at 20 °C: undo
-  // the table's location errors (two fixed-point steps), turn back to C = 0, undo the
-  // workpiece's expansion about its datum.
-  Vector3d toWorkpiece(const Vector3d& q) const {
+  // Machine coordinates of a point (tip coordinates) -> the part frame at 20 °C: undo the
+  // table's location errors (a rigid motion), turn back to C = 0, less the placement error,
+  // less the part frame's origin (machine coordinates at C = 0), undo the part's expansion
+  // about its datum (the blank's bottom centre).
+  Vector3d toWorkpiece(const Vector3d& q) const { return toWorkpieceAt(q, pos_.c_deg); }
+  // The same with the table at another C (the tool's place in the part while C turns).
+  Vector3d toWorkpieceAt(const Vector3d& q, double c_deg) const {
     // The table's location errors as a rigid motion about the C axis at the table surface
     // (a clamped workpiece moves with the table as one body; ER0T, a radial growth of the
     // table, does not move it).
@@ -652,12 +790,24 @@ class VirtualMachine : public gcode::MachineInterface {
     const Vector3d t(e[0] * 1e-3, e[1] * 1e-3, e[2] * 1e-3);
     Vector3d p = pivot + R.transpose() * (q - t - pivot);
     const double sense = m_.c.positive_is_clockwise ? -1.0 : 1.0;
-    const double a = -degToRad(sense * pos_.c_deg);
+    const double a = -degToRad(sense * c_deg);
     const Eigen::Vector2d c = m_.c_axis_centre_mm, d = p.head<2>() - c;
     p.head<2>() = c + Eigen::Vector2d(std::cos(a) * d.x() - std::sin(a) * d.y(), std::sin(a) * d.x() + std::cos(a) * d.y());
     p -= tr_.artifact.placement_error_mm;  // where the part really sits on the table
+    p -= w_->frame_origin_mm;              // machine at C = 0 -> part frame
     return w_->datum() + (p - w_->datum()) / (1.0 + partAlpha() * workpieceAbove20K());
   }
+  // Where the C axis is in the part frame (at 20 °C): the image of the axis under the same
+  // steps (placement, frame origin, expansion about the datum); the tool circles about it
+  // when C turns. For the thermal test piece it is the origin.
+  Eigen::Vector2d cAxisInPart() const {
+    Vector3d p(m_.c_axis_centre_mm.x(), m_.c_axis_centre_mm.y(), 0);
+    p -= tr_.artifact.placement_error_mm;
+    p -= w_->frame_origin_mm;
+    return (w_->datum() + (p - w_->datum()) / (1.0 + partAlpha() * workpieceAbove20K())).head<2>();
+  }
+  // A part angle th appears in the machine at th + s C: s = -1 when +C turns the table clockwise.
+  double cSense() const { return m_.c.positive_is_clockwise ? -1.0 : 1.0; }
   // The part's expansion coefficient: the truth's when it states one, else the material's.
   double partAlpha() const {
     if (tr_.artifact.alpha_per_K) return *tr_.artifact.alpha_per_K;
@@ -682,7 +832,88 @@ class VirtualMachine : public gcode::MachineInterface {
     const bool ball = tool_ == m_.probe.tool;
     const double reach = ball ? 0.5 * r : std::max(0.0, r - 0.2);
     const double bottom = ball ? w.z() - 0.866 * r : w.z();
+    if (bottom + 1e-6 >= stock_.max().z()) return false;  // above the stock: no cell can be higher
     return stock_.topUnder(w.head<2>(), reach) > bottom + 1e-6;
+  }
+
+  // The lowest point of what is in the spindle, below the tip (the probe's ball reaches r
+  // below its centre; a flat end mill's tip is its bottom).
+  double bottomBelowTip() const { return tool_ == m_.probe.tool ? tipRadius() : 0.0; }
+
+  // Obstacles (adapter, washers, clamps) must not be touched. The tool is a vertical
+  // cylinder of its radius (the probe: of its ball's radius) from its bottom upward; it
+  // touches an obstacle where its axis comes closer than the two radii while its bottom is
+  // below the obstacle's top. Exact for a straight move in the part frame: the stretch of the
+  // move within reach (a disk interval) and the lowest bottom there (linear in the move).
+  void checkObstacles(const Vector3d& w0, const Vector3d& w1, const std::string& what) const {
+    if (!w_ || w_->obstacles.empty()) return;
+    const double r = tipRadius(), below = bottomBelowTip();
+    for (const auto& o : w_->obstacles) {
+      const double reach = o.radius_mm + r - 1e-9;
+      const Eigen::Vector2d u = w0.head<2>(), v = (w1 - w0).head<2>(), d = u - o.centre_mm;
+      double lo = 0, hi = 1;
+      const double A = v.squaredNorm(), B = v.dot(d), C = d.squaredNorm() - reach * reach;
+      if (A < 1e-18) {
+        if (C >= 0) continue;
+      } else {
+        const double disc = B * B - A * C;
+        if (disc <= 0) continue;
+        lo = std::max(0.0, (-B - std::sqrt(disc)) / A);
+        hi = std::min(1.0, (-B + std::sqrt(disc)) / A);
+        if (lo > hi) continue;
+      }
+      const double z_lo = w0.z() + lo * (w1.z() - w0.z()), z_hi = w0.z() + hi * (w1.z() - w0.z());
+      const double s = z_lo <= z_hi ? lo : hi;
+      if (std::min(z_lo, z_hi) - below < o.z_max_mm - 1e-9) {
+        const Vector3d at = w0 + s * (w1 - w0);
+        throw SafetyError(what + " would touch the " + o.name + " (an obstacle) at X " + formatNumber(at.x(), 3) + " Y " +
+                          formatNumber(at.y(), 3) + " Z " + formatNumber(at.z(), 3) + " (part frame)");
+      }
+    }
+  }
+  // The same while C turns: the tool circles about the axis in the part frame.
+  void checkObstaclesArc(const Eigen::Vector2d& axis, double rho, double lo, double span, double z_tip,
+                         const std::string& what) const {
+    if (!w_ || w_->obstacles.empty()) return;
+    const double r = tipRadius(), below = bottomBelowTip();
+    for (const auto& o : w_->obstacles)
+      if (z_tip - below < o.z_max_mm - 1e-9 && arcDistance(o.centre_mm, axis, rho, lo, span) < o.radius_mm + r - 1e-9)
+        throw SafetyError(what + " turns the table so that the tool would touch the " + o.name +
+                          " (an obstacle): tool at radius " + formatNumber(rho, 3) + " mm from the C axis, Z " +
+                          formatNumber(z_tip, 3) + " (part frame)");
+  }
+
+  // Turning the table under a still tool: allowed above the stock, and below its top when
+  // the tool stays clear of all material it could meet: its edge outside the largest radius
+  // (about the C axis) of material higher than the tool's bottom, plus a clearance of 0.5 mm
+  // (the height field's cells are 0.25 mm). The test waits at r = 130 mm, z = -12.1 mm while
+  // the table turns ~1500 times; the radius is cached until a cut changes the stock.
+  void checkTurn(const MachinePosition& to, const std::string& what) const {
+    const Vector3d w = toWorkpiece(tipActual(pos_.xyz_mm));
+    const double r = tipRadius(), bottom = w.z() - bottomBelowTip();
+    const Eigen::Vector2d axis = cAxisInPart();
+    const double rho = (w.head<2>() - axis).norm();
+    if (bottom < stock_.max().z() + 1e-9) {
+      const double material = stock_.maxMaterialRadius(axis, bottom);
+      if (!(rho - r > material + kTurnClearance_mm))
+        throw SafetyError(what + " turns the table with the tool below the top of the stock and within reach of its "
+                          "material (tool edge " + formatNumber(rho - r, 3) + " mm from the C axis; material up to " +
+                          formatNumber(material, 3) + " mm, plus " + formatNumber(kTurnClearance_mm) + " mm clearance)");
+    }
+    double lo = 0, span = 0;
+    turnArc(w, axis, to.c_deg - pos_.c_deg, lo, span);
+    checkObstaclesArc(axis, rho, lo, span, w.z(), what);
+  }
+  static constexpr double kTurnClearance_mm = 0.5;
+
+  // The arc a still tool at part position w describes when C changes by dc_deg: it starts at
+  // its angle about the axis and sweeps -s dC (counterclockwise positive), normalised here to
+  // a counterclockwise [lo, lo + span] of at most one turn.
+  void turnArc(const Vector3d& w, const Eigen::Vector2d& axis, double dc_deg, double& lo, double& span) const {
+    const double start = std::atan2(w.y() - axis.y(), w.x() - axis.x());
+    const double sweep = -cSense() * degToRad(dc_deg);
+    span = std::min(std::fabs(sweep), 2 * kPi);
+    lo = sweep >= 0 ? start : start - span;
   }
 
   void checkWorkpiecePath(const MachinePosition& to, const std::string& what) const {
@@ -699,11 +930,8 @@ class VirtualMachine : public gcode::MachineInterface {
                           " Y " + formatNumber(w.y(), 3) + " Z " + formatNumber(w.z(), 3) + " (workpiece frame)");
       }
     }
-    if (to.c_deg != pos_.c_deg) {
-      const Vector3d w = toWorkpiece(tipActual(pos_.xyz_mm));
-      if (w.z() - (tool_ == m_.probe.tool ? tipRadius() : 0.0) < stock_.max().z() + 1e-9)
-        throw SafetyError(what + " turns the table with the tool below the top of the stock");
-    }
+    if (!w_->obstacles.empty() && a != b) checkObstacles(toWorkpiece(tipActual(a)), toWorkpiece(tipActual(b)), what);
+    if (to.c_deg != pos_.c_deg) checkTurn(to, what);
   }
 
   // Seed 000 Eq. 3.16 with I1 = I2 = I (the printed E*I^2 is read as E*I, notes §4.8):
@@ -714,6 +942,26 @@ class VirtualMachine : public gcode::MachineInterface {
     return (L1 * L1 * L1 / 3.0 + L1 * (L2 - L1) * (L2 + L1) / 6.0 + L2 * (L2 - L1) * (2 * L2 + L1) / 6.0) / (E * I);
   }
 
+  // Compliance of tool and structure along a machine direction (unit, XY).
+  double compliance(const parts::CuttingTool& t, const Vector3d& away_m) const {
+    double c = toolCompliance(t);
+    const auto& k = tr_.stiffness_N_per_um;
+    for (int i = 0; i < 2; ++i)
+      if (k(i) > 0) c += away_m(i) * away_m(i) * 1e-3 / k(i);
+    return c;
+  }
+
+  // The machine's state when a cut starts (truth.json relates the as-cut surfaces to it).
+  void recordCutState() {
+    CutState s;
+    s.time_s = t_;
+    s.tool = tool_;
+    s.location = locationErrors();
+    s.tool_um = toolDriftUm();
+    s.part_dT_K = nodeRise(tr_.artifact.node);
+    cut_states_.push_back(s);
+  }
+
   // A cutting feed move: material removed along the real tool path; the mean cutting force
   // from the removal rate (P = k_c Q, F_t = P / v_c); the radial force K_r F_t pushes the
   // tool away from the material, which bends (Eq. 3.16) and the structure yields (F/k); the
@@ -721,11 +969,14 @@ class VirtualMachine : public gcode::MachineInterface {
   void cutMove(const MachinePosition& to, double F) {
     const parts::CuttingTool& t = *cutter();
     const double r = t.diameter_mm / 2;
-    if (to.c_deg != pos_.c_deg || to.b_deg != pos_.b_deg)
-      throw InputError("", 0, "cutting with a rotary axis moving is not modelled");
+    if (to.b_deg != pos_.b_deg || (to.c_deg != pos_.c_deg && to.xyz_mm != pos_.xyz_mm))
+      throw InputError("", 0, "cutting with a rotary axis moving together with X/Y/Z (or B) is not modelled");
+    if (to.c_deg != pos_.c_deg) return arcCut(to, F);
     const Vector3d w0 = toWorkpiece(tipActual(pos_.xyz_mm)), w1 = toWorkpiece(tipActual(to.xyz_mm));
-    if (w0.z() < m_.table_surface_z_mm - 1e-9 || w1.z() < m_.table_surface_z_mm - 1e-9)
+    const double table_z = m_.table_surface_z_mm - w_->frame_origin_mm.z();
+    if (w0.z() < table_z - 1e-9 || w1.z() < table_z - 1e-9)
       throw SafetyError("feed move (G1/G2/G3) would cut into the table");
+    checkObstacles(w0, w1, "feed move (G1/G2/G3)");
     const double len = (to.xyz_mm - pos_.xyz_mm).norm();
     const double dt = len / F * 60.0;
     const Removal rem = stock_.removeHeightField(w0, w1, r);
@@ -745,26 +996,102 @@ class VirtualMachine : public gcode::MachineInterface {
         Fn = w_->material.radial_force_ratio * Ft;
         const Vector3d away_w(-lateral.x() / lateral.norm(), -lateral.y() / lateral.norm(), 0);
         const Vector3d away_m = workpieceDirToMachine(away_w);
-        double c = toolCompliance(t);
-        const auto& k = tr_.stiffness_N_per_um;
-        for (int i = 0; i < 2; ++i)
-          if (k(i) > 0) c += away_m(i) * away_m(i) * 1e-3 / k(i);
-        defl = away_w * (Fn * c);
+        defl = away_w * (Fn * compliance(t, away_m));
       }
     }
     // The cut is made warm; in the 20 °C frame the tool's radius shrinks with the part.
     const double r_w = r / (1.0 + partAlpha() * workpieceAbove20K());
-    stock_.recordCut(w0 + defl, w1 + defl, r_w, t_);
-    const Vector3d drift = toolDriftUm();
-    cuts_.push_back({{"time_s", t_}, {"tool", tool_},
-                     {"p0_mm", {w0.x() + defl.x(), w0.y() + defl.y(), w0.z()}},
-                     {"p1_mm", {w1.x() + defl.x(), w1.y() + defl.y(), w1.z()}},
-                     {"radius_mm", r_w}, {"removed_mm3", rem.volume_mm3}, {"Ft_N", Ft}, {"Fn_N", Fn},
-                     {"deflection_um", {defl.x() * 1e3, defl.y() * 1e3}},
-                     {"tool_drift_um", {drift.x(), drift.y(), drift.z()}}});
+    const int tag = static_cast<int>(cut_states_.size());
+    const bool stored = stock_.recordCut(w0 + defl, w1 + defl, r_w, t_, tag);
+    // A run of cutting moves that cannot touch the blank (a ring around the part, which the
+    // controller follows as thousands of chords) is one entry in cuts.json; a single such
+    // move keeps its full entry.
+    const bool air = rem.volume_mm3 == 0 && !stored;
+    if (air && air_run_motion_ == motions_ && !cuts_.empty()) {
+      auto& e = cuts_.back();
+      if (!e.contains("kind")) e = {{"time_s", e["time_s"]}, {"tool", e["tool"]}, {"kind", "air"}, {"moves", 1}};
+      e["moves"] = e["moves"].get<long>() + 1;
+      e["until_s"] = t_ + dt;
+    } else {
+      recordCutState();
+      const Vector3d drift = toolDriftUm();
+      cuts_.push_back({{"time_s", t_}, {"tool", tool_},
+                       {"p0_mm", {w0.x() + defl.x(), w0.y() + defl.y(), w0.z()}},
+                       {"p1_mm", {w1.x() + defl.x(), w1.y() + defl.y(), w1.z()}},
+                       {"radius_mm", r_w}, {"removed_mm3", rem.volume_mm3}, {"Ft_N", Ft}, {"Fn_N", Fn},
+                       {"deflection_um", {defl.x() * 1e3, defl.y() * 1e3}},
+                       {"tool_drift_um", {drift.x(), drift.y(), drift.z()}}});
+    }
     const double t0 = t_;
     move(dt, F);
     traceRow("cut", to, F, t0);
+    if (air) air_run_motion_ = motions_;
+    pos_ = to;
+  }
+
+  // Cutting while C turns (pre-machining step 1, seed 004 L2006: "circular milled by turning
+  // the rotary table; no linear axis is moved"): in the part frame the still tool circles
+  // the C axis. Removal and force as for a line (force from the removal rate over the first
+  // turn, which removes all there is); the radial force pushes the tool away from the
+  // material: outward when the removed material lies inside the circle. A turn whose swept
+  // annulus cannot reach the material is no cut (the test's load turns the table a thousand
+  // times with the tool waiting outside the part): timed and checked only.
+  void arcCut(const MachinePosition& to, double F_deg_per_min) {
+    const parts::CuttingTool& t = *cutter();
+    const double r = t.diameter_mm / 2;
+    const Vector3d q = tipActual(pos_.xyz_mm);
+    const Vector3d w0 = toWorkpiece(q);
+    const double table_z = m_.table_surface_z_mm - w_->frame_origin_mm.z();
+    if (w0.z() < table_z - 1e-9) throw SafetyError("feed move (G1) would cut into the table");
+    const Eigen::Vector2d axis = cAxisInPart();
+    const double rho = (w0.head<2>() - axis).norm();
+    const double dc = to.c_deg - pos_.c_deg;
+    const double start = std::atan2(w0.y() - axis.y(), w0.x() - axis.x());
+    const double sweep = -cSense() * degToRad(dc);
+    double lo = 0, span = 0;
+    turnArc(w0, axis, dc, lo, span);
+    checkObstaclesArc(axis, rho, lo, span, w0.z(), "feed move (G1)");
+    const double dt = std::fabs(dc) / F_deg_per_min * 60.0;
+    const double turns = std::fabs(sweep) / (2 * kPi);
+    const double cut_sweep = std::clamp(sweep, -2 * kPi, 2 * kPi);
+    const bool reaches = w0.z() < stock_.max().z() && rho - r <= stock_.maxMaterialRadius(axis, w0.z()) + kTurnClearance_mm;
+    const double t0 = t_;
+    if (reaches) {
+      const Removal rem = stock_.removeHeightFieldArc(axis, rho, start, cut_sweep, w0.z(), r);
+      double Ft = 0, Fn = 0, defl_mm = 0;  // radial, outward positive
+      const double dt_cut = dt / std::max(1.0, turns);  // the first turn removes it all
+      Vector3d away_m = Vector3d::Zero();
+      if (rem.volume_mm3 > 0 && dt_cut > 0) {
+        const double vc = kPi * t.diameter_mm * std::fabs(spindle_rpm_) / 60.0;  // mm/s
+        Ft = w_->material.specific_cutting_force_N_per_mm2 * (rem.volume_mm3 / dt_cut) / vc;
+        const double lateral = rem.mean_radius_mm - rho;  // > 0: the material lay outside the circle
+        if (std::fabs(lateral) > 0.05 * r && rho > 1e-9) {
+          Fn = w_->material.radial_force_ratio * Ft;
+          const double sign = lateral > 0 ? -1.0 : 1.0;
+          // Radial in the machine: from the axis to the still tool.
+          const Eigen::Vector2d radial_m = (q.head<2>() - m_.c_axis_centre_mm).normalized();
+          away_m = Vector3d(sign * radial_m.x(), sign * radial_m.y(), 0);
+          defl_mm = sign * Fn * compliance(t, away_m);
+        }
+      }
+      const double r_w = r / (1.0 + partAlpha() * workpieceAbove20K());
+      const int tag = static_cast<int>(cut_states_.size());
+      recordCutState();
+      stock_.recordArc(axis, rho + defl_mm, start, cut_sweep, w0.z(), r_w, t_, tag);
+      const Vector3d drift = toolDriftUm();
+      const Eigen::Vector2d e0(std::cos(start), std::sin(start));
+      cuts_.push_back({{"time_s", t_}, {"tool", tool_}, {"kind", "arc"},
+                       {"centre_mm", {axis.x(), axis.y()}}, {"path_radius_mm", rho + defl_mm}, {"z_mm", w0.z()},
+                       {"start_deg", radToDeg(start)}, {"sweep_deg", radToDeg(cut_sweep)}, {"turns", turns},
+                       {"radius_mm", r_w}, {"removed_mm3", rem.volume_mm3}, {"Ft_N", Ft}, {"Fn_N", Fn},
+                       {"deflection_um", {e0.x() * defl_mm * 1e3, e0.y() * defl_mm * 1e3}},
+                       {"radial_deflection_um", defl_mm * 1e3},
+                       {"tool_drift_um", {drift.x(), drift.y(), drift.z()}}});
+    }
+    c_move_rpm_ = cMoveRpm(to, dt);
+    move(dt, 0.0);
+    c_move_rpm_ = 0;
+    traceRow(reaches ? "cut" : "feed", to, F_deg_per_min, t0);
     pos_ = to;
   }
 
@@ -807,9 +1134,14 @@ class VirtualMachine : public gcode::MachineInterface {
 
  public:
   const Stock& stock() const { return stock_; }
-  void enableTrace() {
+  const std::vector<CutState>& cutStates() const { return cut_states_; }
+  double partAlphaPerK() const { return partAlpha(); }
+  // With several programs a last column names the program each line belongs to.
+  void enableTrace(bool with_program) {
     trace_on_ = true;
-    trace_ << "time_s,duration_s,line,kind,x_mm,y_mm,z_mm,b_deg,c_deg,feed_mm_per_min,tool\n";
+    trace_program_ = with_program;
+    trace_ << "time_s,duration_s,line,kind,x_mm,y_mm,z_mm,b_deg,c_deg,feed_mm_per_min,tool"
+           << (with_program ? ",program" : "") << "\n";
   }
   std::string traceText() const { return trace_.str(); }
   std::string cutsJson() const { return cuts_.dump(1) + "\n"; }
@@ -839,9 +1171,53 @@ class VirtualMachine : public gcode::MachineInterface {
 
 }  // namespace
 
+parts::Workpiece placeOnMachine(const parts::TestPiece& piece, const parts::Machine& machine) {
+  if (const auto* t = piece.thermalTestPiece()) {
+    if (!machine.c.present)
+      throw InputError(machine.file, 0, "the thermal test piece is cut and indexed on a C axis, and this machine has none");
+    parts::Workpiece w = *piece.stock;
+    w.frame_origin_mm = parts::partOriginOnMachine(*t, machine.c_axis_centre_mm, machine.table_surface_z_mm);
+    return w;
+  }
+  if (!piece.stock)
+    throw InputError(piece.file, 0, "kind: " + piece.kind + " is not machined: it stands on the table as it is, not as a workpiece");
+  return *piece.stock;
+}
+
+namespace {
+
+gcode::ProgramDialect dialectOf(const std::string& program_file, const parts::Machine& machine) {
+  const std::string ext = std::filesystem::path(program_file).extension().string();
+  gcode::ProgramDialect dialect = machine.dialect == parts::Dialect::LinuxCnc ? gcode::ProgramDialect::LinuxCnc
+                                                                              : gcode::ProgramDialect::FanucMacroB;
+  if (ext == ".ngc") dialect = gcode::ProgramDialect::LinuxCnc;
+  if (ext == ".nc" || ext == ".tap") dialect = gcode::ProgramDialect::FanucMacroB;
+  return dialect;
+}
+
+}  // namespace
+
 SimulationOutputs simulateProgram(const std::string& program_file, const std::string& text,
                                   const parts::Machine& machine, const SimulationPart& part,
                                   const MachineTruth& truth, std::uint64_t seed) {
+  return simulatePrograms({{program_file, text}}, machine, part, truth, seed);
+}
+
+SimulationOutputs simulatePrograms(const std::vector<ProgramSource>& programs, const parts::Machine& machine,
+                                   const SimulationPart& given, const MachineTruth& truth, std::uint64_t seed) {
+  if (programs.empty()) throw InputError("", 0, "simulate needs at least one program");
+  SimulationPart part = given;
+  std::optional<parts::Workpiece> placed;
+  if (given.test_piece) {
+    if (given.artifact || given.workpiece)
+      throw InputError("", 0, "simulate needs exactly one part on the table: a test piece, or an artifact or workpiece, not both");
+    if (const auto* a = given.test_piece->sphereArtifact()) {
+      part.artifact = a;
+    } else {
+      placed = placeOnMachine(*given.test_piece, machine);
+      part.workpiece = &*placed;
+    }
+  }
   if (part.artifact && !machine.c.present)
     throw InputError(machine.file, 0, "the sphere artifact stands on a rotary table, and this machine has no C axis");
   if (part.artifact && truth.artifact.node >= 0 && !truth.artifact.alpha_per_K)
@@ -850,49 +1226,74 @@ SimulationOutputs simulateProgram(const std::string& program_file, const std::st
     throw InputError("", 0, "simulate needs exactly one part on the table: a sphere artifact or a workpiece");
   if (!part.cmm_points.empty() && !part.workpiece)
     throw InputError("", 0, "CMM points need a workpiece (kind: workpiece) as the part");
-  const std::string ext = std::filesystem::path(program_file).extension().string();
-  gcode::ProgramDialect dialect = machine.dialect == parts::Dialect::LinuxCnc ? gcode::ProgramDialect::LinuxCnc
-                                                                              : gcode::ProgramDialect::FanucMacroB;
-  if (ext == ".ngc") dialect = gcode::ProgramDialect::LinuxCnc;
-  if (ext == ".nc" || ext == ".tap") dialect = gcode::ProgramDialect::FanucMacroB;
-  gcode::Interpreter interp(dialect, program_file, text);
-  VirtualMachine vm(machine, part, truth, seed);
-  if (part.trace) vm.enableTrace();
-  const auto run = interp.run(vm);
-  vm.finish();
+  const bool multi = programs.size() > 1;
+  if (multi && part.trace)
+    for (const auto& p : programs)
+      if (std::filesystem::path(p.file).filename().string().find(',') != std::string::npos)
+        throw InputError(p.file, 0, "a program file name with a comma cannot be named in trace.csv's program column");
 
+  VirtualMachine vm(machine, part, truth, seed);
+  if (part.trace) vm.enableTrace(multi);
   SimulationOutputs out;
-  out.blocks = run.blocks_executed;
+  bool last_fanuc = false;
+  for (const auto& p : programs) {
+    const gcode::ProgramDialect dialect = dialectOf(p.file, machine);
+    last_fanuc = dialect == gcode::ProgramDialect::FanucMacroB;
+    gcode::Interpreter interp(dialect, p.file, p.text);
+    vm.beginProgram(p.file, last_fanuc);
+    const auto run = interp.run(vm);
+    vm.endProgram();
+    out.blocks += run.blocks_executed;
+  }
+  vm.finish();
+  if (!multi) vm.ensureLog(last_fanuc);
+
   out.end_time_s = vm.time();
-  out.log_text = vm.logText();
+  out.logs = vm.logs();
+  if (!out.logs.empty()) {
+    out.log_name = out.logs.front().name;
+    out.log_text = out.logs.front().text;
+  }
   out.trace_csv = vm.traceText();
   if (part.workpiece) {
     out.cuts_json = vm.cutsJson();
     if (!part.cmm_points.empty())
-      out.cmm_csv = measureOnCmm(vm.stock(), *part.workpiece, part.cmm_points, part.cmm_points_file, seed);
+      out.cmm_csv = measureOnCmm(vm.stock(), *part.workpiece, part.cmm_points, part.cmm_points_file, seed, 5.0,
+                                 vm.partAlphaPerK());
   }
 
-  if (dialect == gcode::ProgramDialect::FanucMacroB) out.log_name = "dprnt.txt";
-  else out.log_name = vm.logName().empty() ? "controller.log" : vm.logName();
   out.inputs_csv = vm.inputsText();
   const auto& events = vm.events();
   out.probe_events = static_cast<long>(events.size());
 
   // Canonical points: the logged points (as reported) joined with the event behind each.
-  std::map<long, const ProbeEvent*> by_line;
+  std::map<std::pair<int, long>, const ProbeEvent*> by_line;
   for (const auto& e : events)
-    if (e.log_line > 0) by_line[e.log_line] = &e;
+    if (e.log_line > 0) by_line[{e.log_stream, e.log_line}] = &e;
   // The points CSV needs the planner's log convention ("PT cycle position point x y z").
-  std::vector<gcode::LoggedProbePoint> logged;
-  bool pt_log = true;
-  try {
-    logged = gcode::parseProbeLog(out.log_text, out.log_name);
-  } catch (const InputError&) {
-    pt_log = false;
+  struct Logged {
+    int stream;
+    gcode::LoggedProbePoint p;
+  };
+  std::vector<Logged> logged;
+  std::vector<std::string> not_pt;
+  for (std::size_t i = 0; i < out.logs.size(); ++i) {
+    try {
+      for (const auto& p : gcode::parseProbeLog(out.logs[i].text, out.logs[i].name)) logged.push_back({static_cast<int>(i), p});
+    } catch (const InputError&) {
+      not_pt.push_back(out.logs[i].name);
+    }
   }
+  std::string files;
+  for (const auto& p : programs) files += (files.empty() ? "" : " ") + p.file;
+  // A sphere artifact's positions are spheres (S<position>); any other part's are points of
+  // its features, which the evaluation maps through the plan manifest (P<position>).
+  const std::string feature_prefix = part.artifact ? "S" : "P";
   std::ostringstream csv;
-  csv << "# probeloop simulate " << program_file << ", seed " << seed << "\n";
-  if (!pt_log) csv << "# the log does not follow the planner's PT convention: no points\n";
+  csv << "# probeloop simulate " << files << ", seed " << seed << "\n";
+  if (!multi && !not_pt.empty()) csv << "# the log does not follow the planner's PT convention: no points\n";
+  if (multi)
+    for (const auto& n : not_pt) csv << "# the log " << n << " does not follow the planner's PT convention: no points from it\n";
   csv << "time_s,cycle,c_deg,feature,point,x_mm,y_mm,z_mm,nx,ny,nz\n";
   nlohmann::ordered_json jt;
   jt["format"] = "probeloop-truth";
@@ -907,18 +1308,23 @@ SimulationOutputs simulateProgram(const std::string& program_file, const std::st
   std::map<int, std::pair<int, std::array<double, 7>>> per_cycle;  // cycle -> (n, sum)
   std::map<int, double> cycle_time;
   const auto& names = geometry::LocationErrors::names();
-  for (const auto& p : logged) {
-    const auto it = by_line.find(p.line);
+  for (const auto& [stream, p] : logged) {
+    const auto it = by_line.find({stream, p.line});
+    const std::string& log_name = out.logs[static_cast<std::size_t>(stream)].name;
     if (it == by_line.end())
-      throw InputError(out.log_name, p.line, "log line without a probe event (the program logged without probing)");
+      throw InputError(log_name, p.line, "log line without a probe event (the program logged without probing)");
     const ProbeEvent& e = *it->second;
-    csv << formatNumber(e.time_s, 3) << "," << p.cycle << "," << formatNumber(e.c_deg) << ",S" << p.position << ","
-        << p.point << "," << formatNumber(e.reported_tip_mm.x(), decimals) << ","
+    csv << formatNumber(e.time_s, 3) << "," << p.cycle << "," << formatNumber(e.c_deg) << "," << feature_prefix
+        << p.position << "," << p.point << "," << formatNumber(e.reported_tip_mm.x(), decimals) << ","
         << formatNumber(e.reported_tip_mm.y(), decimals) << "," << formatNumber(e.reported_tip_mm.z(), decimals) << ","
         << formatNumber(e.approach.x(), 6) << "," << formatNumber(e.approach.y(), 6) << ","
         << formatNumber(e.approach.z(), 6) << "\n";
-    nlohmann::ordered_json je{{"time_s", e.time_s}, {"log_line", e.log_line}, {"cycle", p.cycle},
-                              {"position", p.position}, {"point", p.point}, {"c_deg", e.c_deg}};
+    nlohmann::ordered_json je{{"time_s", e.time_s}, {"log_line", e.log_line}};
+    if (multi) je["log"] = log_name;
+    je["cycle"] = p.cycle;
+    je["position"] = p.position;
+    je["point"] = p.point;
+    je["c_deg"] = e.c_deg;
     for (int j = 0; j < 7; ++j) je[names[j]] = e.location[j];
     je["tool_um"] = {e.tool_um.x(), e.tool_um.y(), e.tool_um.z()};
     je["atc_um"] = {e.atc_um.x(), e.atc_um.y(), e.atc_um.z()};
@@ -942,6 +1348,12 @@ SimulationOutputs simulateProgram(const std::string& program_file, const std::st
     }
   }
   jt["tool_changes"] = vm.toolChangeLog();
+  // A machined test piece with measurement features: what a perfect CMM at 20 °C finds on
+  // the surfaces as cut, and the errors the evaluation should find from them.
+  if (given.test_piece && given.test_piece->thermalTestPiece() && part.workpiece) {
+    const auto t = testPieceTruth(*given.test_piece, vm.stock(), vm.cutStates());
+    writeTestPieceTruth(t, jt);
+  }
   out.points_csv = csv.str();
   out.truth_json = jt.dump(1) + "\n";
   return out;
