@@ -22,7 +22,6 @@
 #include "parts/machine.hpp"
 #include "parts/plan_manifest.hpp"
 #include "parts/sphere_artifact.hpp"
-#include "parts/workpiece.hpp"
 #include "parts/test_piece.hpp"
 #include "planner/sphere_cycle.hpp"
 #include "planner/test_piece.hpp"
@@ -127,8 +126,8 @@ int cmdSimulate(const std::vector<std::string>& program_files, const std::string
 }
 
 int cmdEvaluate(const std::string& points_file, const std::string& manifest_file, const std::string& out_dir,
-                const std::string& format, bool free_radius, const std::string& scene_file, double exaggeration,
-                const std::string& compare_with) {
+                const std::string& format, bool free_radius, const std::string& scene_file,
+                std::optional<double> exaggeration_opt, const std::string& compare_with, double gauge_resolution_um) {
   const auto m = parts::readManifest(manifest_file);
   evaluate::EvaluateRequest req;
   req.input_file = points_file;
@@ -136,7 +135,13 @@ int cmdEvaluate(const std::string& points_file, const std::string& manifest_file
   req.free_radius = free_radius;
   req.compare_with = compare_with;
   req.out_dir = out_dir;
+  req.gauge_resolution_um = gauge_resolution_um;
   const auto f = evaluate::evaluateTestPiece(m, req);
+  // Errors of a few um: x10000 puts them on the scale of a sphere campaign's table (0.3 m),
+  // x1000 on the scale of a 0.2 m test piece (docs/report-thermal-test-piece.md).
+  const double exaggeration = exaggeration_opt.value_or(f.sphere ? 10000.0 : 1000.0);
+  if (!scene_file.empty() && f.thermal_test_piece && f.thermal_test_piece->route == evaluate::TtpRoute::Gauge)
+    throw InputError(points_file, 0, "--scene: dial-gauge readings give no measured surfaces to draw (use a CMM export or an on-machine log)");
   std::string scene;
   if (!scene_file.empty() && f.sphere) {
     std::vector<report::CycleCentres> cc;
@@ -235,7 +240,8 @@ int main(int argc, char** argv) {
 
   std::string artifact, machine, out = ".", dialect = "machine", manifest, truth, points,
               format = "auto", scene;
-  double step_um = 1.0, exaggeration = 10000.0;
+  double step_um = 1.0, gauge_resolution_um = 1.0;
+  std::optional<double> exaggeration;
   std::uint64_t seed = 1;
   bool free_radius = false;
 
@@ -282,7 +288,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"auto", "linuxcnc", "fanuc", "csv", "cmm", "gauge"}))->capture_default_str();
   ev->add_flag("--free-radius", free_radius, "sphere centres from the free-radius fit (default: known radius)");
   ev->add_option("--scene", scene, "also write a glTF scene (the sphere campaign, or the test piece with its deviations)");
-  ev->add_option("--exaggeration", exaggeration, "scale of the error vectors in the scene")->capture_default_str();
+  ev->add_option("--exaggeration", exaggeration, "scale of the error vectors in the scene (default: 10000 sphere campaign, 1000 test piece)");
+  ev->add_option("--gauge-resolution-um", gauge_resolution_um,
+                 "thermal test piece, dial-gauge readings: the gauge's resolution (rectangular; not stated in the thesis)")
+      ->capture_default_str()->check(CLI::PositiveNumber);
   ev->add_option("--compare", compare_with, "thermal test piece: another run's evaluation.json (seed 004 Table 7.2 reductions)")
       ->check(CLI::ExistingFile);
 
@@ -335,7 +344,8 @@ int main(int argc, char** argv) {
     if (*simc) return cmdSimulate(sim_programs, machine, part, truth, out, seed, cmm_points, sim_trace);
     if (*fit) return cmdFit(fa);
     if (*gum) return cmdGum(gum_model, gum_mcm || gum_trials > 0, gum_trials, seed, gum_digits, gum_json);
-    if (*ev) return cmdEvaluate(points, manifest, out, format, free_radius, scene, exaggeration, compare_with);
+    if (*ev)
+      return cmdEvaluate(points, manifest, out, format, free_radius, scene, exaggeration, compare_with, gauge_resolution_um);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "probeloop: error: %s\n", e.what());
     return 1;

@@ -14,7 +14,7 @@
 #include "model/outputs.hpp"
 #include "model/talc.hpp"
 #include "parts/error_model_file.hpp"
-#include "parts/sphere_artifact.hpp"
+#include "parts/test_piece.hpp"
 #include "report/model_report.hpp"
 
 namespace probeloop::cli {
@@ -47,13 +47,9 @@ model::Campaign campaignFor(const model::ErrorModel& m, const ModelArgs& a) {
   return model::loadCampaign(in, er);
 }
 
-std::optional<model::ArtifactLengths> artifactLengths(const std::string& part) {
+std::optional<model::ExpansionLevers> expansionLevers(const std::string& part) {
   if (part.empty()) return std::nullopt;
-  const auto art = parts::loadSphereArtifact(part);
-  if (!(art.alpha_um_per_m_K > 0))
-    throw InputError(part, 0, "uncertainty.alpha_um_per_m_K: the expansion candidates need the artifact's expansion coefficient");
-  return model::ArtifactLengths{art.alpha_um_per_m_K, art.centreHeightAboveTable() + art.sphereRadius(),
-                                art.radius_from_axis_mm};
+  return parts::expansionLevers(parts::loadTestPiece(part));
 }
 
 void writeReport(const std::string& path, const nlohmann::json& fit, const nlohmann::json* diag) {
@@ -88,8 +84,8 @@ int runDiagnose(const ModelArgs& a) {
   const auto m = parts::loadErrorModel(a.models.front());
   const auto c = campaignFor(m, a);
   model::DiagnoseOptions opt;
-  opt.artifact = artifactLengths(a.part);
-  opt.artifact_path = a.part;
+  opt.levers = expansionLevers(a.part);
+  opt.part_path = a.part;
   opt.model_path = a.models.front();
   const auto d = model::diagnose(c, m, opt);
   const auto dj = model::diagnosisJson(c, m, d);
@@ -130,7 +126,7 @@ int runAdd(const ModelArgs& a) {
     e.tau_fixed = a.tau_fixed;
     if (e.tau_fixed && !e.tau_s) throw InputError("", 0, "model add: --tau-fixed needs --tau-s");
   }
-  const auto lengths = artifactLengths(a.part);
+  const auto levers = expansionLevers(a.part);
   for (auto& c : m.channels)
     for (auto& x : c.effects) x.just_added = false;
   std::vector<std::string> created;
@@ -138,15 +134,12 @@ int runAdd(const ModelArgs& a) {
     model::Effect ce = e;
     ce.just_added = true;
     if (*kind == model::EffectKind::Expansion) {
-      ce.alpha_um_per_m_K = a.alpha ? *a.alpha : lengths ? lengths->alpha_um_per_m_K : 0;
-      ce.length_mm = a.length_mm ? *a.length_mm
-                     : !lengths ? 0
-                     : name.rfind("EZ0T", 0) == 0 ? lengths->height_mm
-                     : name.rfind("ER0T", 0) == 0 ? lengths->radius_mm
-                                                  : 0;
-      if (!(ce.alpha_um_per_m_K > 0 && ce.length_mm > 0))
+      ce.alpha_um_per_m_K = a.alpha ? *a.alpha : levers ? levers->alpha_um_per_m_K : 0;
+      ce.length_mm = a.length_mm ? *a.length_mm : levers ? levers->lengthFor(name).value_or(0) : 0;
+      if (!(ce.alpha_um_per_m_K > 0 && ce.length_mm != 0))
         throw InputError("", 0, "model add expansion on " + name +
-                                    ": needs --part (a sphere artifact: EZ0T uses its height, ER0T its radius from the C axis) "
+                                    ": needs --part (a sphere artifact: EZ0T uses its height, ER0T its radius from the C axis; "
+                                    "a thermal test piece: EZ the Z paths' height, ETTP -2 x the facets' apothem) "
                                     "or --alpha-um-per-m-K and --length-mm");
     }
     auto it = std::find_if(m.channels.begin(), m.channels.end(), [&](const model::ChannelModel& c) { return c.channel == name; });
@@ -200,7 +193,7 @@ std::function<int()> addModelCommands(CLI::App& app, CLI::App*& group) {
   auto* dia = group->add_subcommand("diagnose", "Where the model fails and which effect is missing, ranked, with the command that adds it");
   dia->add_option("model", a->models, "error model (YAML)")->required()->expected(1)->check(CLI::ExistingFile);
   data(dia);
-  dia->add_option("--part", a->part, "sphere artifact (YAML): enables the artifact-expansion candidates")->check(CLI::ExistingFile);
+  dia->add_option("--part", a->part, "the test piece (YAML: sphere artifact, thermal test piece): enables its expansion candidates")->check(CLI::ExistingFile);
   dia->add_option("--report", a->report, "also write the HTML report to this file");
   auto* add = group->add_subcommand("add", "Add an effect to channels of a model file (marked just_added: the next fit shows before and after)");
   add->add_option("effect", a->kind, "drift, static, lag, transient or expansion")
@@ -210,9 +203,9 @@ std::function<int()> addModelCommands(CLI::App& app, CLI::App*& group) {
   add->add_option("--input", a->input, "inputs.csv column the effect reads");
   add->add_option("--tau-s", a->tau_s, "lag/transient: time constant to start from, s")->check(CLI::PositiveNumber);
   add->add_flag("--tau-fixed", a->tau_fixed, "keep the time constant fixed");
-  add->add_option("--part", a->part, "expansion: the sphere artifact (YAML) giving alpha and the lengths")->check(CLI::ExistingFile);
+  add->add_option("--part", a->part, "expansion: the test piece (YAML) giving alpha and the levers")->check(CLI::ExistingFile);
   add->add_option("--alpha-um-per-m-K", a->alpha, "expansion: coefficient")->check(CLI::PositiveNumber);
-  add->add_option("--length-mm", a->length_mm, "expansion: length")->check(CLI::PositiveNumber);
+  add->add_option("--length-mm", a->length_mm, "expansion: signed lever L of alpha L dT, mm");
   auto* talc = group->add_subcommand("talc", "Adaptive replay of seed 004 Ch. 6 (TALC) over a densely measured campaign: P99 reduction as Tables 6.5/6.7");
   talc->add_option("--inputs", a->inputs, "inputs.csv of the campaign")->required()->check(CLI::ExistingFile);
   talc->add_option("--errors", a->errors, "errors.csv of the campaign (measured densely)")->required()->check(CLI::ExistingFile);

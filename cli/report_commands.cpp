@@ -52,19 +52,22 @@ int runTtp(TtpArgs a) {
   a.options.second_file = a.second;
   a.options.r_test_file = a.r_test;
 
+  // Both outputs are made in memory first: an error in either leaves no file written.
+  std::string html, gltf;
+  if (!a.html.empty())
+    html = report::thermalTestPieceReportHtml(evaluation, second ? &*second : nullptr, r_test ? &*r_test : nullptr,
+                                              report::defaultVegaPath(), a.options);
+  if (!a.scene.empty()) {
+    const parts::PlanManifest manifest = parts::readManifest(a.manifest);
+    gltf = naming(a.evaluation, [&] { return report::thermalTestPieceSceneGltf(manifest, evaluation, a.exaggeration); });
+  }
+
   if (!a.html.empty()) {
-    const std::string html = report::thermalTestPieceReportHtml(evaluation, second ? &*second : nullptr,
-                                                                r_test ? &*r_test : nullptr, report::defaultVegaPath(),
-                                                                a.options);
     writeFileAtomic(a.html, html);
     std::printf("Wrote %s (thermal-test-piece report: %s%s%s)\n", a.html.c_str(), a.evaluation.c_str(),
                 second ? (" and " + a.second).c_str() : "", r_test ? (", R-test " + a.r_test).c_str() : "");
   }
   if (!a.scene.empty()) {
-    const parts::PlanManifest manifest = parts::readManifest(a.manifest);
-    const std::string gltf = naming(a.evaluation, [&] {
-      return report::thermalTestPieceSceneGltf(manifest, evaluation, a.exaggeration);
-    });
     writeFileAtomic(a.scene, gltf);
     std::printf("Wrote %s (glTF scene of %s, deviation vectors x%g)\n", a.scene.c_str(), a.manifest.c_str(),
                 a.exaggeration);
@@ -93,7 +96,8 @@ std::function<int()> addReportCommands(CLI::App& app, CLI::App*& group) {
                        ->check(CLI::ExistingFile);
   ttp->add_option("--scene", a->scene, "write a glTF scene of the piece with its deviations to this file")
       ->needs(manifest);
-  ttp->add_option("--exaggeration", a->exaggeration, "scale of the deviation vectors in the scene")
+  ttp->add_option("--exaggeration", a->exaggeration,
+                  "scale of the deviation vectors in the scene: 1000 draws a 1 um change as a 1 mm line")
       ->capture_default_str();
   ttp->add_option("--table-alpha", a->options.table_alpha_um_per_m_K,
                   "Eq. 7.10 for the table: expansion coefficient, um/(m K) (seed 004: cast iron)")

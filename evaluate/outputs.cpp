@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "core/csv.hpp"
+#include "evaluate/budget_json.hpp"
 #include "evaluate/sphere_campaign.hpp"
 
 namespace probeloop::evaluate {
@@ -18,7 +19,6 @@ ordered_json errorsJson(const LocationErrors& e) {
   return j;
 }
 ordered_json vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
-ordered_json finiteOrNull(double v) { return std::isfinite(v) ? ordered_json(v) : ordered_json(); }
 }  // namespace
 
 std::string errorSeriesCsv(const CampaignEvaluation& e) {
@@ -76,25 +76,7 @@ std::string evaluationJson(const CampaignEvaluation& e, const parts::PlanManifes
     jc["formulas_eq_5_4_to_5_10"] = c.formulas ? errorsJson(*c.formulas) : ordered_json();
     jc["model_residual_xy_um"] = c.model_residual_xy_um;
     jc["model_residual_z_um"] = c.model_residual_z_um;
-    for (const auto& b : c.budgets) {
-      ordered_json jb;
-      jb["quantity"] = b.quantity;
-      jb["unit"] = b.unit;
-      jb["value"] = b.value;
-      jb["u_c"] = b.u_c;
-      jb["nu_eff"] = finiteOrNull(b.nu_eff);
-      jb["k"] = b.k;
-      jb["U"] = b.U;
-      jb["contributions"] = ordered_json::array();
-      for (const auto& ct : b.contributions)
-        jb["contributions"].push_back({{"input", ct.input},
-                                       {"type", std::string(1, ct.type)},
-                                       {"distribution", ct.distribution},
-                                       {"basis", ct.basis},
-                                       {"u", ct.u},
-                                       {"dof", finiteOrNull(ct.dof)}});
-      jc["budgets"].push_back(jb);
-    }
+    for (const auto& b : c.budgets) jc["budgets"].push_back(budgetJson(b));
     for (const auto& s : c.spheres) {
       ordered_json js;
       js["position"] = s.position;

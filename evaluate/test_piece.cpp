@@ -65,7 +65,7 @@ EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateReq
   } else {
     throw InputError("", 0, "--format '" + r.format + "': expected auto, cmm, linuxcnc, fanuc, csv or gauge");
   }
-  if (!r.compare_with.empty()) e.comparison = compareSpans(e.spans, r.compare_with);
+  if (!r.compare_with.empty()) e.comparison = compareSpans(e, r.compare_with);
   EvaluationFiles f;
   f.errors_csv = ttpErrorsCsv(e);
   f.evaluation_json = ttpEvaluationJson(e);

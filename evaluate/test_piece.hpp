@@ -2,8 +2,9 @@
 // reads the manifest, calls these, writes the returned texts (writeFileAtomic) and prints
 // stdout_text. No mathematics in the CLI.
 //
-// Kinds: sphere_artifact (seed 004 Ch. 5: evaluate/sphere_campaign.hpp; outputs unchanged
-// byte for byte) and thermal_test_piece (seed 004 Ch. 7: evaluate/thermal_test_piece.hpp).
+// Kinds: sphere_artifact (seed 004 Ch. 5: evaluate/sphere_campaign.hpp; the writers of
+// evaluate/outputs.cpp, as before the dispatch) and thermal_test_piece (seed 004 Ch. 7:
+// evaluate/thermal_test_piece.hpp).
 #pragma once
 #include <optional>
 #include <string>

@@ -14,6 +14,7 @@
 #include "core/atomic_file.hpp"
 #include "core/csv.hpp"
 #include "core/error.hpp"
+#include "core/units.hpp"
 #include "geometry/fit.hpp"
 #include "geometry/least_squares.hpp"
 #include "geometry/minimum_zone.hpp"
@@ -358,14 +359,15 @@ uncertainty::Budget valueBudget(const ValueSpec& v, const BudgetContext& ctx) {
     const double dT = m.ttp.cmm.temperature_half_width_K;
     if (ctx.predicted)
       add("part temperature in the CMM room (Eq. 7.6)", 'B', "rectangular",
-          "alpha dT |E| (seed 004 Eq. 7.6), " + alphaBasis(m) + ", dT within +-" + num(dT) +
-              " K: scales with the measured value",
+          "U_dT = alpha dT |E| (seed 004 Eq. 7.6) read as a rectangular half-width, " + alphaBasis(m) + ", dT within +-" +
+              num(dT) + " K: scales with the measured value",
           0);
     else
       add("part temperature in the CMM room (Eq. 7.6)", 'B', "rectangular",
-          "alpha dT |E| (seed 004 Eq. 7.6): " + alphaBasis(m) + ", dT within +-" + num(dT) +
+          "U_dT = alpha dT |E| (seed 004 Eq. 7.6, a 'measurement deviation assessment'), read as the half-width of a "
+          "rectangular distribution (our interpretation): u = U_dT / sqrt(3); " + alphaBasis(m) + ", dT within +-" + num(dT) +
               " K (thermal_test_piece.cmm.temperature_half_width; seed 004 L2145)",
-          alpha * 1e-6 * dT * std::fabs(v.value) / std::sqrt(3.0));
+          std::fabs(parts::measurementDeviationEq76_um(alpha, dT, v.value)) / std::sqrt(3.0));
   } else {
     const double dT = m.ttp.on_machine_temperature_change_K;
     double v2 = 0;
@@ -467,44 +469,28 @@ std::string missingMessage(const std::map<std::string, bool>& ok, const std::vec
   return q + " not evaluated: " + ids + " (cycle " + std::to_string(cycle) + ") " + (absent.size() == 1 ? "has " : "have ") + why;
 }
 
-std::vector<parts::EvaluationRule> formulaList(TtpRoute route) {
-  std::vector<parts::EvaluationRule> r;
-  if (route == TtpRoute::Gauge) {
-    r.push_back({"EX_um", "(g_X2(t_i) - g_X1(t_i)) / 2", "seed 004 Eq. 7.7", "dial-gauge readings of X1_k, X2_k of cycle i"});
-    r.push_back({"EY_um", "(g_Y2(t_i) - g_Y1(t_i)) / 2", "seed 004 Eq. 7.8", "dial-gauge readings of Y1_k, Y2_k of cycle i"});
-    r.push_back({"ETTP_um", "(g_Y2 + g_Y1 + g_X2 + g_X1) / 4: the radial form, half of Eq. 7.3's", "seed 004 Eq. 7.9",
-                 "the four facets of cycle i"});
-    r.push_back({"dT_K", "-E_TTP / (alpha R)", "seed 004 Eq. 7.10; sign: docs/thermal-test-piece.md §4", "E_TTP (Eq. 7.9)"});
-    return r;
-  }
-  r.push_back({"d_mm", "n . (c - O): distance of the facet's LS plane from the origin along its own outward normal",
-               "docs/thermal-test-piece.md §4", "facets"});
-  r.push_back({"depth_mm", "depth of the Z path's LS plane below the datum plane at x = 0, y = y_j",
-               "docs/thermal-test-piece.md §4", "Z paths"});
-  r.push_back({"beta_urad", "atan2(n_x, n_z) of the Z path's LS plane", "seed 004 Eq. 7.5; docs/thermal-test-piece.md §4", "Z paths"});
-  r.push_back({"EX_um", "[(d_X2(t_i) - d_X2(t_0)) - (d_X1(t_i) - d_X1(t_0))] / 2",
-               "seed 004 Eq. 7.1 with the printed '- d_X1(t0)' read as '+' (notes/seed004.md §11 item 10)",
-               "X1_k, X2_k of cycle i and of cycle 0"});
-  r.push_back({"EY_um", "[(d_Y2(t_i) - d_Y2(t_0)) - (d_Y1(t_i) - d_Y1(t_0))] / 2",
-               "seed 004 Eq. 7.2 with the printed '- d_Y1(t0)' read as '+' (notes/seed004.md §11 item 10)",
-               "Y1_k, Y2_k of cycle i and of cycle 0"});
-  r.push_back({"EZ_um", "d_Z(t_i) - d_Z(t_0)", "seed 004 Eq. 7.4", "Z path of cycle i and of cycle 0"});
-  r.push_back({"EB_urad", "beta(t_i) - beta(t_0)", "seed 004 Eq. 7.5", "Z path of cycle i and of cycle 0"});
-  r.push_back({"ETTP_um", "[l_X(t_i) - l_X(t_0) + l_Y(t_i) - l_Y(t_0)] / 2, l = d_1 + d_2", "seed 004 Eq. 7.3",
-               "the four facets of cycle i and of cycle 0"});
-  r.push_back({"ETTP_7_9_um", "mean of the four one-sided changes d(t_i) - d(t_0): half of Eq. 7.3",
-               "seed 004 Eq. 7.9 with g = d(t_i) - d(t_0) (notes/seed004.md §11 item 11)", "the four facets of cycle i and of cycle 0"});
-  r.push_back({"dT_K", "-E_TTP,7.9 / (alpha R)", "seed 004 Eq. 7.10; sign: docs/thermal-test-piece.md §4 (a piece cut warm is smaller at 20 C)",
-               "E_TTP in the radial form (Eq. 7.9)"});
-  r.push_back({"EX_printed_um", "[d_X2(t_i) - d_X2(t_0) - d_X1(t_i) - d_X1(t_0)] / 2 (as printed; d_X1(t_0) does not cancel)",
-               "seed 004 Eq. 7.1 as printed", "X1_k, X2_k of cycle i and of cycle 0"});
-  r.push_back({"EY_printed_um", "[d_Y2(t_i) - d_Y2(t_0) - d_Y1(t_i) - d_Y1(t_0)] / 2 (as printed)", "seed 004 Eq. 7.2 as printed",
-               "Y1_k, Y2_k of cycle i and of cycle 0"});
-  return r;
+// The manifest's rules (parts::thermalTestPieceEvaluation), for the gauge route those of the
+// values it gives.
+std::vector<parts::EvaluationRule> formulas(const parts::PlanManifest& m, TtpRoute route) {
+  if (route != TtpRoute::Gauge) return m.evaluation;
+  std::vector<parts::EvaluationRule> out;
+  for (const auto& r : m.evaluation)
+    if (r.output == "EX_um" || r.output == "EY_um" || r.output == "ETTP_um" || r.output == "dT_K") out.push_back(r);
+  return out;
 }
 
 uncertainty::Budget zeroBudget(const std::string& q, const std::string& unit, double k) {
   return uncertainty::combine(q, unit, 0.0, {}, k);
+}
+
+// A cycle's row before its values: its phase (cycle 0: the reference) and time.
+template <class Phases, class Times>
+TtpCycleResult cycleResult(int c, const Phases& ph, const Times& times) {
+  TtpCycleResult cr;
+  cr.cycle = c;
+  cr.phase = ph.count(c) ? ph.at(c) : (c == 0 ? "reference" : "");
+  cr.time_s = times.count(c) ? times.at(c) : 0.0;
+  return cr;
 }
 
 const char* kQuantities[6] = {"EX_um", "EY_um", "EZ_um", "EB_urad", "ETTP_um", "dT_K"};
@@ -521,7 +507,7 @@ TtpEvaluation evaluateImpl(const parts::PlanManifest& m, const TtpPoints& in, co
   e.route = in.route;
   e.points = static_cast<int>(in.points.size());
   e.coverage_k = opt.coverage_k;
-  e.formulas = formulaList(in.route);
+  e.formulas = formulas(m, in.route);
   const std::string& file = in.file;
 
   // Points grouped by feature, in file order.
@@ -621,6 +607,19 @@ TtpEvaluation evaluateImpl(const parts::PlanManifest& m, const TtpPoints& in, co
       pm = fitPlaneModel(v, idx, n.direction, opt.form_mz);
     } catch (const GeometryError& x) {
       featureError(file, pts, idx, n.id, x.what());
+    }
+    // The fitted plane against its nominal one: mislabelled points (X1_3's labelled X1_4) would
+    // otherwise give errors off by tenths of a mm silently, and a Z path's depth divides by n_z.
+    {
+      const Vector3d nn = n.direction.normalized();
+      const double angle_deg = radToDeg(std::acos(std::clamp(pm.n.dot(nn), -1.0, 1.0)));
+      const double off_mm = (pm.c - n.point_mm).dot(nn);
+      if (angle_deg > kNominalAngleDeg || std::fabs(off_mm) > kNominalDistanceMm)
+        throw InputError(file, pts[static_cast<std::size_t>(idx.front())].line,
+                         "feature " + n.id + " (" + std::to_string(idx.size()) + " points, the first on this line): after the datum "
+                         "alignment its fitted plane's normal is " + num(angle_deg) + " deg from the nominal one and its centre " +
+                             num(off_mm) + " mm from the nominal surface (at most " + num(kNominalAngleDeg) + " deg and " +
+                             num(kNominalDistanceMm) + " mm): mislabelled points? (manifest " + m.file + ")");
     }
     TtpFeatureResult f;
     f.id = n.id;
@@ -726,10 +725,7 @@ TtpEvaluation evaluateImpl(const parts::PlanManifest& m, const TtpPoints& in, co
     if (!ref.by_side.count(s)) throw InputError(m.file, 0, std::string("the manifest has no reference ") + s + " feature (cycle 0)");
 
   for (const auto& [c, feats] : cf) {
-    TtpCycleResult cr;
-    cr.cycle = c;
-    cr.phase = ph.count(c) ? ph.at(c) : (c == 0 ? "reference" : "");
-    cr.time_s = times.count(c) ? times.at(c) : 0.0;
+    TtpCycleResult cr = cycleResult(c, ph, times);
     if (c == 0) {
       for (int j = 0; j < 6; ++j) cr.values.push_back(zeroBudget(kQuantities[j], kUnits[j], opt.coverage_k));
       cr.ETTP_7_9_um = 0;  // the printed forms of Eqs. 7.1/7.2 are defined for i >= 1 only
@@ -837,14 +833,17 @@ TtpEvaluation evaluateThermalTestPieceGauge(const parts::PlanManifest& m, const 
   e.route = TtpRoute::Gauge;
   e.points = static_cast<int>(r.readings.size());
   e.coverage_k = opt.coverage_k;
-  e.formulas = formulaList(TtpRoute::Gauge);
+  e.formulas = formulas(m, TtpRoute::Gauge);
   e.gauge_resolution_um = opt.gauge_resolution_um;
   const double u_read = opt.gauge_resolution_um / std::sqrt(12.0);
   e.scatter.type_b_sigma_mm = u_read * 1e-3;
   e.notes.push_back("E_Z and E_B are not available from the dial gauge on the facets (seed 004 L2121 measures the Z paths with a "
-                    "separate depth gauge set-up); E_TTP is Eq. 7.9's radial form, half of Eq. 7.3's");
+                    "separate depth gauge set-up)");
+  e.notes.push_back("the readings are g = d(t_i) - d(t_0) per facet, so Eqs. 7.7-7.9 are the formulas below with g for the "
+                    "changes of d; E_TTP is Eq. 7.3 (diametral) as on the other routes: (g_X1 + g_X2 + g_Y1 + g_Y2) / 2, twice "
+                    "Eq. 7.9's radial mean, which is reported as ETTP_7_9_um and gives dT (Eq. 7.10)");
   e.notes.push_back("gauge uncertainty: the thesis states none; the budget reads the gauge resolution (" +
-                    num(opt.gauge_resolution_um) + " um, TtpOptions::gauge_resolution_um) as rectangular per reading and per zero setting");
+                    num(opt.gauge_resolution_um) + " um, --gauge-resolution-um) as rectangular per reading and per zero setting");
   std::map<std::string, double> g;
   for (const auto& x : r.readings) g[x.facet] = x.g_um;
   const auto cf = cycleFeatures(m);
@@ -852,6 +851,10 @@ TtpEvaluation evaluateThermalTestPieceGauge(const parts::PlanManifest& m, const 
   const auto times = cycleTimes(m);
   if (!cf.count(0)) throw InputError(m.file, 0, "the manifest lists no reference features (cycle 0)");
   const auto& ref = cf.at(0);
+  for (const char* s : kSides)
+    if (!ref.by_side.count(s))
+      throw InputError(m.file, 0, std::string("the manifest has no reference ") + s +
+                                      " facet (cycle 0): the dial-gauge readings of that side are relative to it (seed 004 L2121)");
   auto reading = [&](const parts::ManifestFeature* f, const parts::ManifestFeature* f0) -> std::optional<double> {
     if (!f || !g.count(f->nominal.id)) return std::nullopt;
     return g.at(f->nominal.id) - (g.count(f0->nominal.id) ? g.at(f0->nominal.id) : 0.0);  // relative to the reference facet
@@ -859,10 +862,7 @@ TtpEvaluation evaluateThermalTestPieceGauge(const parts::PlanManifest& m, const 
   const double alpha = m.material_alpha_um_per_m_K;
   const double dT = m.ttp.on_machine_temperature_change_K;
   for (const auto& [c, feats] : cf) {
-    TtpCycleResult cr;
-    cr.cycle = c;
-    cr.phase = ph.count(c) ? ph.at(c) : (c == 0 ? "reference" : "");
-    cr.time_s = times.count(c) ? times.at(c) : 0.0;
+    TtpCycleResult cr = cycleResult(c, ph, times);
     if (c == 0) {
       for (int j : {0, 1, 4, 5}) cr.values.push_back(zeroBudget(kQuantities[j], kUnits[j], opt.coverage_k));
       cr.ETTP_7_9_um = 0;
@@ -890,7 +890,7 @@ TtpEvaluation evaluateThermalTestPieceGauge(const parts::PlanManifest& m, const 
         if (std::isfinite(alpha)) t2 += std::pow(wi * alpha * 1e-6 * dT * L * 1e3, 2) / 3.0;
       }
       const std::string basis = "resolution " + num(opt.gauge_resolution_um) +
-                                " um (TtpOptions::gauge_resolution_um; not stated in the thesis), rectangular, res/sqrt(12)";
+                                " um (--gauge-resolution-um; not stated in the thesis), rectangular, res/sqrt(12)";
       cs.push_back({"dial gauge readings", 'B', "rectangular", basis + " per reading", u_read * std::sqrt(w2), kInf});
       cs.push_back({"dial gauge zero on the reference facets", 'B', "rectangular", basis + " per side's zero setting",
                     u_read * std::sqrt(w2), kInf});
@@ -907,10 +907,11 @@ TtpEvaluation evaluateThermalTestPieceGauge(const parts::PlanManifest& m, const 
     if (v["X1"] && v["X2"]) cr.values.push_back(budget("EX_um", ge.EX_um, {{"X2", 0.5}, {"X1", -0.5}}));  // seed 004 Eq. 7.7
     if (v["Y1"] && v["Y2"]) cr.values.push_back(budget("EY_um", ge.EY_um, {{"Y2", 0.5}, {"Y1", -0.5}}));  // seed 004 Eq. 7.8
     if (v["X1"] && v["X2"] && v["Y1"] && v["Y2"]) {
-      const auto b = budget("ETTP_um", ge.ETTP_um, {{"X1", 0.25}, {"X2", 0.25}, {"Y1", 0.25}, {"Y2", 0.25}});  // seed 004 Eq. 7.9
-      cr.values.push_back(b);
+      // Eq. 7.3 with g = d(t_i) - d(t_0): [(g_X1 + g_X2) + (g_Y1 + g_Y2)] / 2, exactly twice Eq. 7.9.
+      cr.values.push_back(budget("ETTP_um", 2 * ge.ETTP_um, {{"X1", 0.5}, {"X2", 0.5}, {"Y1", 0.5}, {"Y2", 0.5}}));
+      const auto radial = budget("ETTP_7_9_um", ge.ETTP_um, {{"X1", 0.25}, {"X2", 0.25}, {"Y1", 0.25}, {"Y2", 0.25}});  // seed 004 Eq. 7.9
       cr.ETTP_7_9_um = ge.ETTP_um;
-      cr.values.push_back(temperatureBudget(m, b, opt.coverage_k, false));
+      cr.values.push_back(temperatureBudget(m, radial, opt.coverage_k, false));
     }
     e.cycles.push_back(cr);
   }
@@ -940,28 +941,49 @@ std::vector<TtpSpan> ttpSpans(const std::vector<TtpCycleResult>& cycles) {
       if (c.cycle == l) t_last = c.time_s;
     s.period_h = c0 ? (t_last - c0->time_s) / 3600 : 0;
     for (const char* q : {"EX_um", "EY_um", "EZ_um", "EB_urad", "ETTP_um"}) {
-      const uncertainty::Budget* hi = nullptr;
-      const uncertainty::Budget* lo = nullptr;
-      int chi = 0, clo = 0, n = 0;
-      for (const auto& c : cycles) {
-        if (c.cycle > l) continue;
-        const auto* b = c.value(q);
-        if (!b) continue;
-        ++n;
-        if (!hi || b->value > hi->value) hi = b, chi = c.cycle;
-        if (!lo || b->value < lo->value) lo = b, clo = c.cycle;
+      // Every cycle 0..l must have the value: a span over the cycles that happen to be there
+      // would read as the period's span.
+      std::map<int, const uncertainty::Budget*> at;
+      for (const auto& c : cycles)
+        if (c.cycle <= l && c.value(q)) at[c.cycle] = c.value(q);
+      bool measured = false;  // a quantity this route gives at all in the period
+      for (const auto& [c, b] : at) measured = measured || c > 0;
+      if (!measured) continue;
+      TtpSpanValue v;
+      v.quantity = q;
+      for (int c = 0; c <= l; ++c)
+        if (!at.count(c)) v.missing_cycles.push_back(c);
+      if (v.complete()) {
+        const uncertainty::Budget* hi = nullptr;
+        const uncertainty::Budget* lo = nullptr;
+        for (const auto& [c, b] : at) {
+          if (!hi || b->value > hi->value) hi = b;
+          if (!lo || b->value < lo->value) lo = b;
+        }
+        // The two extremes' U combined as if independent: conservative (both share the reference
+        // cut, which cancels in their difference) and blind to another cycle being the true extreme.
+        v.span = hi->value - lo->value;
+        v.U = std::sqrt(hi->U * hi->U + lo->U * lo->U);
       }
-      if (n < 2) continue;
-      // The two extremes' U combined as if independent: conservative (both share the reference
-      // cut, which cancels in their difference) and blind to another cycle being the true extreme.
-      s.values.push_back({q, hi->value - lo->value, std::sqrt(hi->U * hi->U + lo->U * lo->U), chi, clo});
+      s.values.push_back(v);
     }
     out.push_back(s);
   }
   return out;
 }
 
-TtpComparison compareSpans(const std::vector<TtpSpan>& mine, const std::string& other) {
+std::string cycleRanges(const std::vector<int>& c) {
+  std::string out;
+  for (std::size_t i = 0; i < c.size();) {
+    std::size_t j = i;
+    while (j + 1 < c.size() && c[j + 1] == c[j] + 1) ++j;
+    out += (out.empty() ? "" : ", ") + std::to_string(c[i]) + (j > i ? "-" + std::to_string(c[j]) : "");
+    i = j + 1;
+  }
+  return out;
+}
+
+TtpComparison compareSpans(const TtpEvaluation& e, const std::string& other) {
   using nlohmann::json;
   json j;
   try {
@@ -971,31 +993,71 @@ TtpComparison compareSpans(const std::vector<TtpSpan>& mine, const std::string& 
   }
   TtpComparison c;
   c.against = other;
+  c.this_route = ttpRouteName(e.route);
   try {
     if (j.value("format", "") != "probeloop-evaluation" || j.value("kind", "") != "thermal_test_piece")
-      throw InputError(other, 0, "not a thermal-test-piece evaluation.json (format probeloop-evaluation, kind thermal_test_piece)");
-    for (const auto& s : mine) {
+      throw InputError(other, 0,
+                       "not a thermal-test-piece evaluation.json (format probeloop-evaluation, kind thermal_test_piece; found kind '" +
+                           j.value("kind", "") + "')");
+    c.other_route = j.at("input").at("route").get<std::string>();
+    // The same quantity on both sides: the formula of each compared output must be this run's.
+    auto formulaOf = [](const std::vector<parts::EvaluationRule>& rules, const std::string& q) -> const parts::EvaluationRule* {
+      for (const auto& r : rules)
+        if (r.output == q) return &r;
+      return nullptr;
+    };
+    auto otherFormula = [&](const std::string& q) -> std::string {
+      for (const auto& f : j.at("formulas"))
+        if (f.at("output").get<std::string>() == q) return f.at("formula").get<std::string>();
+      return "";
+    };
+    auto sameQuantity = [&](const std::string& q) {
+      const auto* mine = formulaOf(e.formulas, q);
+      const std::string theirs = otherFormula(q);
+      if (!mine || theirs != mine->formula)
+        throw InputError(other, 0,
+                         q + " is not the same quantity in both evaluations: this run (route " + c.this_route + ") computes '" +
+                             (mine ? mine->formula : std::string("(no formula)")) + "', " + other + " (route " + c.other_route +
+                             ") '" + (theirs.empty() ? std::string("(no formula)") : theirs) +
+                             "'; re-evaluate it with this probeloop so that both use the same formulas");
+    };
+    for (const auto& s : e.spans) {
       const json* match = nullptr;
       for (const auto& o : j.at("spans"))
         if (o.at("cycles").at(0).get<int>() == s.first && o.at("cycles").at(1).get<int>() == s.last) match = &o;
       if (!match) continue;
+      const std::string period = "cycles " + std::to_string(s.first) + "-" + std::to_string(s.last);
       for (const auto& v : s.values)
-        for (const auto& ov : match->at("values"))
-          if (ov.at("quantity").get<std::string>() == v.quantity) {
-            TtpComparisonRow r;
-            r.period_h = s.period_h;
-            r.quantity = v.quantity;
-            r.this_span = v.span;
-            r.other_span = ov.at("span").get<double>();
-            if (std::fabs(v.span) > 0) r.reduction_percent = parts::spanReductionPercent(v.span, r.other_span);  // Table 7.2
-            c.rows.push_back(r);
+        for (const auto& ov : match->at("values")) {
+          if (ov.at("quantity").get<std::string>() != v.quantity) continue;
+          sameQuantity(v.quantity);
+          const auto other_missing = ov.at("missing_cycles").get<std::vector<int>>();
+          if (!v.complete() || !other_missing.empty()) {
+            c.left_out.push_back(period + " " + v.quantity + ": incomplete in " +
+                                 (!v.complete() ? "this run (cycles " + cycleRanges(v.missing_cycles) + " missing)" : std::string()) +
+                                 (!v.complete() && !other_missing.empty() ? " and in " : "") +
+                                 (!other_missing.empty() ? other + " (cycles " + cycleRanges(other_missing) + " missing)" : std::string()));
+            continue;
           }
+          TtpComparisonRow r;
+          r.period_h = s.period_h;
+          r.quantity = v.quantity;
+          r.this_span = v.span;
+          r.other_span = ov.at("span").get<double>();
+          if (std::fabs(v.span) > 0) r.reduction_percent = parts::spanReductionPercent(v.span, r.other_span);  // Table 7.2
+          c.rows.push_back(r);
+        }
     }
   } catch (const json::exception& x) {
-    throw InputError(other, 0, std::string("spans missing or of the wrong type: ") + x.what());
+    throw InputError(other, 0, std::string("input.route, spans or formulas missing or of the wrong type: ") + x.what());
   }
-  if (c.rows.empty())
-    throw InputError(other, 0, "no period of this evaluation (cycles 0-1, 0-half, 0-last) has the same cycles in the other: nothing to compare");
+  if (c.rows.empty()) {
+    std::string why;
+    for (const auto& l : c.left_out) why += "; " + l;
+    throw InputError(other, 0,
+                     "no complete span of this evaluation (cycles 0-1, 0-half, 0-last) has a complete span of the same cycles in the "
+                     "other: nothing to compare" + why);
+  }
   return c;
 }
 

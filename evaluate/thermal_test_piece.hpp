@@ -12,10 +12,18 @@
 //   normal; d_Z of a Z path = depth of its plane below the datum plane at (x = 0, y = y_j);
 //   beta = atan2(n_x, n_z) (urad).
 // - Cycle i against cycle 0 by parts::ttpErrors (Eqs. 7.1-7.5, 7.9), dT by Eq. 7.10 with the
-//   sign of docs/thermal-test-piece.md §4 (dT = -E_TTP,7.9 / (alpha R)). A missing reference
-//   feature is an InputError ("a missing reference cut"); a missing measurement feature omits
-//   the values that need it, with the reason; a feature with 1-2 points or collinear points is
-//   an InputError naming it, its point count and its lines.
+//   sign of docs/thermal-test-piece.md §4 (dT = -E_TTP,7.9 / (alpha R)). ETTP_um is Eq. 7.3
+//   (diametral) on every route, the dial gauge's too ((g_X1 + g_X2 + g_Y1 + g_Y2) / 2); Eq. 7.9
+//   (radial, half of it) is reported as ETTP_7_9_um. A missing reference feature is an
+//   InputError ("a missing reference cut"); a missing measurement feature omits the values that
+//   need it, with the reason; a feature with 1-2 points or collinear points is an InputError
+//   naming it, its point count and its lines.
+// - After the alignment every fitted Z path and facet must match its nominal feature: normal
+//   within kNominalAngleDeg, centre within kNominalDistanceMm of the nominal surface; otherwise
+//   an InputError naming the file, the feature and the line of its first point ("mislabelled
+//   points?").
+// - The formulas listed are the manifest's (parts::PlanManifest::evaluation); the gauge route
+//   lists those of the values it gives.
 // - Every value carries a budget (uncertainty::combine): point scatter (type A or B, the
 //   larger, as evaluate/location_budget), resolution, machine repeatability, temperature,
 //   datum alignment; for dT also alpha. Terms a manifest does not state are listed with 0 and
@@ -35,12 +43,18 @@
 
 namespace probeloop::evaluate {
 
+// A fitted feature against its nominal one after the alignment (the cut errors are a few um
+// and urad; a mislabelled or misassigned feature is off by degrees or tenths of a mm).
+constexpr double kNominalAngleDeg = 1.0;
+constexpr double kNominalDistanceMm = 0.5;
+
 struct TtpOptions {
   double coverage_k = 2.0;
   bool form_mz = true;    // also the minimum-zone form of every plane (reported, not used)
   bool budgets = true;    // false: values only (Monte Carlo checks)
   // Dial-gauge route: resolution of the gauge, read as a rectangular +-res/2 per reading and
-  // per zero setting. The thesis states no gauge uncertainty; 1 um is a common dial gauge.
+  // per zero setting (CLI: --gauge-resolution-um). The thesis states no gauge uncertainty; 1 um
+  // is a common dial gauge.
   double gauge_resolution_um = 1.0;
 };
 
@@ -94,10 +108,13 @@ struct TtpCycleResult {
   const uncertainty::Budget* value(const std::string& quantity) const;  // nullptr if absent
 };
 
+// A period's span needs the value at every cycle of the period; a span with cycles missing is
+// incomplete: listed with the missing cycles, without span and U, and left out of comparisons.
 struct TtpSpanValue {
   std::string quantity;
-  double span = 0, U = 0;
-  int cycle_max = 0, cycle_min = 0;  // where the extremes lie
+  double span = 0, U = 0;            // complete spans only
+  std::vector<int> missing_cycles;   // cycles of the period without this value
+  bool complete() const { return missing_cycles.empty(); }
 };
 
 struct TtpSpan {
@@ -115,7 +132,9 @@ struct TtpComparisonRow {
 
 struct TtpComparison {
   std::string against;
+  std::string this_route, other_route;  // ttpRouteName of each evaluation
   std::vector<TtpComparisonRow> rows;
+  std::vector<std::string> left_out;     // spans not compared and why (incomplete in either run)
 };
 
 struct TtpEvaluation {
@@ -144,8 +163,13 @@ TtpFrame ttpDatumFrame(const TtpPoints& points);
 
 // Table 7.2: spans per period (first hour = cycles 0-1, half, all; E(t0) = 0 included) and
 // the comparison with another evaluation.json of the same kind (this run = UC, other = C).
+// compareSpans refuses (InputError naming the other file) an evaluation of another kind, or
+// one whose formula for a compared quantity differs from this run's (e.g. an E_TTP of another
+// form): the routes may differ, the quantities may not. Incomplete spans (either run) are left
+// out and listed.
 std::vector<TtpSpan> ttpSpans(const std::vector<TtpCycleResult>& cycles);
-TtpComparison compareSpans(const std::vector<TtpSpan>& this_spans, const std::string& other_evaluation_json);
+std::string cycleRanges(const std::vector<int>& sorted_cycles);  // {3, 4, 5, 8} -> "3-5, 8"
+TtpComparison compareSpans(const TtpEvaluation& e, const std::string& other_evaluation_json);
 
 // A-priori U (k = 2) of every value from the planned points and the specifications alone
 // (type B scatter, no measured values): per route, the largest over the measurement cycles.

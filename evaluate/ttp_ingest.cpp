@@ -1,6 +1,7 @@
 #include "evaluate/ttp_ingest.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -11,6 +12,7 @@
 #include "core/error.hpp"
 #include "core/units.hpp"
 #include "gcode/probe_log.hpp"
+#include "parts/machine.hpp"
 
 namespace probeloop::evaluate {
 
@@ -27,13 +29,11 @@ const char* ttpRouteName(TtpRoute r) {
 
 namespace {
 
-std::string lower(std::string s) {
-  for (auto& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
-bool endsWith(const std::string& s, const std::string& tail) {
-  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+// ".csv" at the end of the path, in any case.
+bool csvExtension(const std::string& path) {
+  static const std::string ext = ".csv";
+  return path.size() >= ext.size() && std::equal(ext.begin(), ext.end(), path.end() - static_cast<std::ptrdiff_t>(ext.size()),
+                                                 [](char e, char c) { return std::tolower(static_cast<unsigned char>(c)) == e; });
 }
 
 // The first non-comment, non-blank line.
@@ -106,20 +106,16 @@ Proximity proximity(const parts::NominalFeature& f, const Vector3d& p, double ma
   return r;
 }
 
-Vector3d rotZ(const Vector3d& v, double rad) {
-  const double c = std::cos(rad), s = std::sin(rad);
-  return {c * v.x() - s * v.y(), s * v.x() + c * v.y(), v.z()};
-}
-
-double sideSign(const parts::PlanManifest& m) { return m.c_positive_is_clockwise ? -1.0 : 1.0; }
-
 }  // namespace
 
+// The table's sense of turning: parts::turnedByTable (docs/conventions.md).
 Vector3d machineToPartDirection(const parts::PlanManifest& m, const Vector3d& d, double c_deg) {
-  return rotZ(d, -sideSign(m) * degToRad(c_deg));
+  const Eigen::Vector2d xy = parts::unturnedByTable(d.head<2>(), c_deg, m.c_positive_is_clockwise);
+  return {xy.x(), xy.y(), d.z()};
 }
 Vector3d partToMachineDirection(const parts::PlanManifest& m, const Vector3d& d, double c_deg) {
-  return rotZ(d, sideSign(m) * degToRad(c_deg));
+  const Eigen::Vector2d xy = parts::turnedByTable(d.head<2>(), c_deg, m.c_positive_is_clockwise);
+  return {xy.x(), xy.y(), d.z()};
 }
 Vector3d machineToPart(const parts::PlanManifest& m, const Vector3d& p, double c_deg) {
   const Vector3d c3(m.c_axis_centre_mm.x(), m.c_axis_centre_mm.y(), 0.0);
@@ -132,7 +128,7 @@ Vector3d partToMachine(const parts::PlanManifest& m, const Vector3d& p, double c
 
 std::string detectTtpFormat(const std::string& path, const std::string& text) {
   const std::string first = firstDataLine(text);
-  const bool csv = first.find(',') != std::string::npos || endsWith(lower(path), ".csv");
+  const bool csv = first.find(',') != std::string::npos || csvExtension(path);
   if (!csv) return "log";  // a PT log: LinuxCNC LOG and Fanuc DPRNT lines parse alike
   const auto h = headerFields(first);
   if (has(h, "g_um")) return "gauge";

@@ -11,9 +11,9 @@
 //   simulator's points CSV time_s,cycle,c_deg,feature,point,x_mm,...; feature "P<position>",
 //   "S<position>" or a feature id): stylus-tip centres in machine coordinates. The manifest
 //   point (feature by position, then point number) gives the approach and C; surface point =
-//   tip + r_tip * approach; then the part frame: undo C about the C axis centre (a part angle
-//   th shows in the machine at th + s C, s = -1 when C+ is clockwise), subtract the part
-//   origin.
+//   tip + r_tip * approach; then the part frame: undo C about the C axis centre
+//   (parts::unturnedByTable: a part angle th shows in the machine at th + s C, s =
+//   parts::tableTurnSign, -1 when C+ is clockwise), subtract the part origin.
 // - Dial gauge (CSV facet,g_um): each facet's reading relative to the reference facet of its
 //   side (seed 004 L2121), positive when the facet lies farther from the C axis than the
 //   reference (g = d(t_i) - d(t_0), the form of parts::ttpErrors).
@@ -85,7 +85,8 @@ std::vector<std::string> assignByNominalGeometry(const std::vector<Eigen::Vector
                                                  const std::string& file, const TtpAssignmentRules& rules = {});
 
 // The part-frame position of a machine-coordinate point measured at C = c_deg (the inverse of
-// the placement the planner uses): Rz(-s C) (p - centre) + centre - part origin.
+// the placement the planner uses): Rz(-s C) (p - centre) + centre - part origin, with
+// parts::turnedByTable / unturnedByTable.
 Eigen::Vector3d machineToPart(const parts::PlanManifest& m, const Eigen::Vector3d& p_machine_mm, double c_deg);
 Eigen::Vector3d partToMachine(const parts::PlanManifest& m, const Eigen::Vector3d& p_part_mm, double c_deg);
 // A direction (no translation) the same way.

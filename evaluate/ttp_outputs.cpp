@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "core/csv.hpp"
+#include "evaluate/budget_json.hpp"
 #include "evaluate/thermal_test_piece.hpp"
 
 namespace probeloop::evaluate {
@@ -16,7 +17,6 @@ using nlohmann::ordered_json;
 namespace {
 
 ordered_json vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
-ordered_json finiteOrNull(double v) { return std::isfinite(v) ? ordered_json(v) : ordered_json(); }
 ordered_json opt(const std::optional<double>& v) { return v ? ordered_json(*v) : ordered_json(); }
 
 std::string routeWords(const TtpEvaluation& e) {
@@ -61,7 +61,8 @@ std::string ttpErrorsCsv(const TtpEvaluation& e) {
     << ", input " << e.input_file << "; relative to the reference cut (cycle 0); U = expanded uncertainty (k = "
     << formatNumber(e.coverage_k) << ")\n";
   if (e.route == TtpRoute::Gauge)
-    o << "# E_X, E_Y, E_TTP by seed 004 Eqs. 7.7-7.9 (E_TTP in the radial form of Eq. 7.9); E_Z and E_B are not measured by the gauge\n";
+    o << "# E_X, E_Y by seed 004 Eqs. 7.7/7.8; E_TTP: Eq. 7.3 (diametral), (g_X1 + g_X2 + g_Y1 + g_Y2) / 2 = twice Eq. 7.9, as on "
+         "the other routes; evaluation.json has Eq. 7.9 and Eq. 7.10; E_Z and E_B are not measured by the gauge\n";
   else
     o << "# E_X, E_Y: Eqs. 7.1/7.2 with the sign typo corrected; E_TTP: Eq. 7.3 (diametral); evaluation.json has the printed forms, "
          "Eq. 7.9 and Eq. 7.10\n";
@@ -148,25 +149,7 @@ std::string ttpEvaluationJson(const TtpEvaluation& e) {
     jc["phase"] = c.phase;
     jc["time_s"] = c.time_s;
     jc["values"] = ordered_json::array();
-    for (const auto& b : c.values) {
-      ordered_json jb;
-      jb["quantity"] = b.quantity;
-      jb["unit"] = b.unit;
-      jb["value"] = b.value;
-      jb["u_c"] = b.u_c;
-      jb["nu_eff"] = finiteOrNull(b.nu_eff);
-      jb["k"] = b.k;
-      jb["U"] = b.U;
-      jb["contributions"] = ordered_json::array();
-      for (const auto& ct : b.contributions)
-        jb["contributions"].push_back({{"input", ct.input},
-                                       {"type", std::string(1, ct.type)},
-                                       {"distribution", ct.distribution},
-                                       {"basis", ct.basis},
-                                       {"u", ct.u},
-                                       {"dof", finiteOrNull(ct.dof)}});
-      jc["values"].push_back(jb);
-    }
+    for (const auto& b : c.values) jc["values"].push_back(budgetJson(b));
     jc["also"] = {{"EX_printed_um", opt(c.EX_printed_um)}, {"EY_printed_um", opt(c.EY_printed_um)}, {"ETTP_7_9_um", opt(c.ETTP_7_9_um)}};
     jc["missing"] = c.missing;
     j["cycles"].push_back(jc);
@@ -174,11 +157,20 @@ std::string ttpEvaluationJson(const TtpEvaluation& e) {
   j["spans"] = ordered_json::array();
   for (const auto& s : e.spans) {
     ordered_json js{{"period_h", s.period_h}, {"cycles", {s.first, s.last}}, {"values", ordered_json::array()}};
-    for (const auto& v : s.values) js["values"].push_back({{"quantity", v.quantity}, {"span", v.span}, {"U", v.U}});
+    for (const auto& v : s.values)
+      js["values"].push_back({{"quantity", v.quantity},
+                              {"complete", v.complete()},
+                              {"span", v.complete() ? ordered_json(v.span) : ordered_json()},
+                              {"U", v.complete() ? ordered_json(v.U) : ordered_json()},
+                              {"missing_cycles", v.missing_cycles}});
     j["spans"].push_back(js);
   }
   if (e.comparison) {
-    ordered_json jc{{"against", e.comparison->against}, {"rows", ordered_json::array()}};
+    ordered_json jc{{"against", e.comparison->against},
+                    {"this_route", e.comparison->this_route},
+                    {"other_route", e.comparison->other_route},
+                    {"rows", ordered_json::array()},
+                    {"left_out", e.comparison->left_out}};
     for (const auto& r : e.comparison->rows)
       jc["rows"].push_back({{"period_h", r.period_h},
                             {"quantity", r.quantity},
@@ -255,7 +247,19 @@ std::string ttpReport(const TtpEvaluation& e) {
       any_missing = true;
       o << "- cycle " << c.cycle << ": " << m << "\n";
     }
-  if (e.route != TtpRoute::Gauge) {
+  if (e.route == TtpRoute::Gauge) {
+    o << "\n## The two E_TTP\n\n"
+         "With g = d(t_i) - d(t_0) per facet, Eq. 7.3 averages the changes of the two diameters, (g_X1 + g_X2 + g_Y1 + g_Y2) / 2, "
+         "Eq. 7.9 the four one-sided changes (÷ 4): ETTP_um is Eq. 7.3, as on the CMM and on-machine routes, and Eq. 7.10 uses "
+         "Eq. 7.9: dT = -E_TTP,7.9 / (alpha R) (docs/thermal-test-piece.md §4).\n\n"
+         "| cycle | ETTP_um (Eq. 7.3) | ETTP_7_9_um (Eq. 7.9) | dT_K (Eq. 7.10) |\n|---|---|---|---|\n";
+    auto val = [](const uncertainty::Budget* b) { return b ? formatNumber(b->value, 3) : std::string("-"); };
+    for (const auto& c : e.cycles) {
+      if (c.cycle == 0) continue;
+      o << "| " << c.cycle << " | " << val(c.value("ETTP_um")) << " | " << (c.ETTP_7_9_um ? formatNumber(*c.ETTP_7_9_um, 3) : "-")
+        << " | " << val(c.value("dT_K")) << " |\n";
+    }
+  } else {
     o << "\n## Printed forms and the two E_TTP\n\n"
          "Eqs. 7.1 and 7.2 are printed with \"- d_X1(t_0)\" (\"- d_Y1(t_0)\"): the reference distance would not cancel "
          "(notes/seed004.md §11 item 10). E_X and E_Y above use \"+\", as the manual form Eq. 7.7 computes; the printed "
@@ -277,7 +281,8 @@ std::string ttpReport(const TtpEvaluation& e) {
   // Spans in Table 7.2's layout.
   if (!e.spans.empty()) {
     o << "\n## Spans of the changes (seed 004 Table 7.2)\n\n"
-         "Span = max - min of E over cycles 0..n, E(t_0) = 0 included. U of a span = root-sum-square of the U of the two "
+         "Span = max - min of E over cycles 0..n, E(t_0) = 0 included; a span needs E at every cycle of its period, "
+         "otherwise it is incomplete (no value; left out of any comparison). U of a span = root-sum-square of the U of the two "
          "extreme values: it ignores that both share the reference cut (which cancels in their difference: conservative) "
          "and that another cycle could be the true extreme.\n\n| period (h) | cycles |";
     std::vector<std::string> qs;
@@ -291,7 +296,9 @@ std::string ttpReport(const TtpEvaluation& e) {
       for (const auto& q : qs) {
         std::string cell = "-";
         for (const auto& v : s.values)
-          if (v.quantity == q) cell = formatNumber(v.span, 2) + " +- " + formatNumber(v.U, 2);
+          if (v.quantity == q)
+            cell = v.complete() ? formatNumber(v.span, 2) + " +- " + formatNumber(v.U, 2)
+                                : "incomplete (cycles " + cycleRanges(v.missing_cycles) + " missing)";
         o << " " << cell << " |";
       }
       o << "\n";
@@ -299,12 +306,17 @@ std::string ttpReport(const TtpEvaluation& e) {
   }
   if (e.comparison) {
     o << "\n## Comparison (Table 7.2 layout): this run (UC) against `" << e.comparison->against
-      << "` (C)\n\nReduction = (UC - C) / UC (parts::spanReductionPercent).\n\n"
+      << "` (C)\n\nRoutes: this run " << e.comparison->this_route << ", the other " << e.comparison->other_route
+      << " (the same formulas, checked). Reduction = (UC - C) / UC (parts::spanReductionPercent).\n\n"
          "| period (h) | quantity | UC span | C span | reduction (%) |\n|---|---|---|---|---|\n";
     for (const auto& r : e.comparison->rows)
       o << "| " << formatNumber(r.period_h, 2) << " | " << r.quantity << " | " << formatNumber(r.this_span, 2) << " | "
         << formatNumber(r.other_span, 2) << " | " << (r.reduction_percent ? formatNumber(*r.reduction_percent, 1) : "- (UC span 0)")
         << " |\n";
+    if (!e.comparison->left_out.empty()) {
+      o << "\nNot compared:\n\n";
+      for (const auto& l : e.comparison->left_out) o << "- " << l << "\n";
+    }
   }
   // Full budget of the last cycle.
   const TtpCycleResult* last = nullptr;
@@ -365,18 +377,22 @@ std::string ttpStdout(const TtpEvaluation& e, const std::string& errors_file, co
     for (const auto& s : e.spans) {
       o << " cycles " << s.first << "-" << s.last << " (" << formatNumber(s.period_h, 2) << " h):";
       for (const auto& v : s.values)
-        if (v.quantity != "EB_urad") o << " " << v.quantity.substr(0, v.quantity.find('_')) << " " << formatNumber(v.span, 2);
+        if (v.quantity != "EB_urad")
+          o << " " << v.quantity.substr(0, v.quantity.find('_')) << " "
+            << (v.complete() ? formatNumber(v.span, 2) : "incomplete (cycles " + cycleRanges(v.missing_cycles) + " missing)");
       o << ";";
     }
     o << "\n";
   }
   if (e.comparison) {
-    o << "Reductions against " << e.comparison->against << ":";
+    o << "Reductions against " << e.comparison->against << " (routes " << e.comparison->this_route << " / "
+      << e.comparison->other_route << "):";
     for (const auto& r : e.comparison->rows)
       if (r.reduction_percent && r.quantity != "EB_urad")
         o << " " << r.quantity.substr(0, r.quantity.find('_')) << " " << formatNumber(r.period_h, 2) << " h "
           << formatNumber(*r.reduction_percent, 1) << " %;";
     o << "\n";
+    for (const auto& l : e.comparison->left_out) o << "Not compared: " << l << "\n";
   }
   o << "Wrote " << errors_file << ", " << json_file << " (budgets) and " << report_file << " (report)\n";
   return o.str();

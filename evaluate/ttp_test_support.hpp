@@ -16,6 +16,7 @@
 #include "core/csv.hpp"
 #include "core/units.hpp"
 #include "parts/plan_manifest.hpp"
+#include "parts/test_piece.hpp"
 #include "parts/thermal_test_piece.hpp"
 
 namespace probeloop::evaluate::ttptest {
@@ -68,17 +69,16 @@ inline Fixture makeFixture(bool clockwise = true) {
   m.part_name = t.name;
   m.part_origin_mm = parts::partOriginOnMachine(t, m.c_axis_centre_mm, m.table_surface_z_mm);
   m.material_name = t.material.name;
-  m.material_alpha_um_per_m_K = t.material.alpha_per_K * 1e6;
+  m.material_alpha_um_per_m_K = t.material.alpha_um_per_m_K;
   m.ttp.z_paths = t.z_paths;
   m.ttp.facets_per_segment = t.facets_per_segment;
-  m.ttp.facet_apothem_mm = t.facet_apothem_mm;
-  m.ttp.test_tool_radius_mm = t.tool(t.test_tool)->diameter_mm / 2;
   m.ttp.eq_7_10_alpha_um_per_m_K = t.eq_7_10_alpha_um_per_m_K;
   m.ttp.alpha_u_um_per_m_K = t.alpha_u_um_per_m_K;
   m.ttp.eq_7_10_radius_mm = t.eq_7_10_radius_mm;
   m.ttp.cmm = t.cmm;
   m.ttp.on_machine_repeatability_um = t.on_machine_repeatability_um;
   m.ttp.on_machine_temperature_change_K = t.on_machine_temperature_change_K;
+  m.evaluation = parts::thermalTestPieceEvaluation();  // as the planner writes it into the manifest
   const auto cycles = parts::cuttingCycles(t);
   for (const auto& c : cycles) {
     parts::ManifestCycle x;

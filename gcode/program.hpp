@@ -4,7 +4,7 @@
 // Contract: coordinates are program coordinates in mm (= machine coordinates of the tool
 // tip or stylus-tip centre, since every program zeroes its work offset with G10 L2 and
 // applies each tool's length offset with G43); angles in degrees; feeds in mm/min, and in
-// deg/min for a move of C alone; times in s. The writers print coordinates to 4 decimals
+// deg/min for a move of C alone (TurnC); times in s. The writers print coordinates to 4 decimals
 // and C, feeds and dwells to 3: a planner that times its ops rounds them the same way
 // (planner/program_walker.hpp). Every probing op names (position, point) for the log line
 // "PT <cycle> <position> <point> <x> <y> <z>" (docs/formats.md#probe-logs).
@@ -35,9 +35,14 @@ struct Dwell { double seconds; };
 // S<rpm> M3 (clockwise seen from the spindle); rpm = 0 is M5.
 struct Spindle { double rpm; };
 struct Coolant { bool on; };  // M8 / M9 (flood)
-// G1: a feed move of X, Y, Z and/or C. A move of C alone is the cut of a tool that stands
-// still while the table turns (F in deg/min), or a turn of the table as a thermal load.
-struct Feed { std::optional<double> x, y, z, c; double feed; };
+// G1: a feed move of X, Y and/or Z (absolute, program coordinates).
+struct Feed { std::optional<double> x, y, z; double feed; };
+// G91 G1 C<delta_deg> F<feed>, then G90: a feed move of C alone by `delta_deg` (F in deg/min),
+// the cut of a tool that stands still while the table turns, or a turn of the table as a
+// thermal load. Incremental on purpose: on a table with C rollover (Fanuc ROA, LinuxCNC
+// WRAPPED_ROTARY) an absolute G1 C360 or C72000 from C0 is a null move; an incremental one
+// turns the commanded amount on every control.
+struct TurnC { double delta_deg; double feed_deg_per_min; };
 // A counted loop: the ops up to the matching LoopEnd run `count` times. LinuxCNC: o-while
 // on the named parameter #<name>; Fanuc: WHILE/DO on a common variable #101, #102 ... by
 // nesting depth (#100 is the cycle number of the probe log).
@@ -45,7 +50,10 @@ struct LoopBegin { int count; std::string name; };
 struct LoopEnd {};
 
 using Op = std::variant<Comment, Rapid, RapidMachineZ, RotateC, ToolChange, ProtectedMove, ProbeMove, Dwell,
-                        RotateB, Spindle, Coolant, Feed, LoopBegin, LoopEnd>;
+                        RotateB, Spindle, Coolant, Feed, TurnC, LoopBegin, LoopEnd>;
+
+// Whether every number of the op is finite (a NaN or an infinity must never reach a program).
+bool allFinite(const Op& op);
 
 // One program file: header, zeroed work offset, the ops, end (M2 / M30).
 struct Program {
@@ -61,7 +69,7 @@ struct Program {
 };
 
 // std::invalid_argument for an unbalanced loop, loops nested deeper than 3 (Fanuc DO1..3),
-// or a probe move in a program without a log.
+// a probe move in a program without a log, or a number that is not finite.
 std::string writeLinuxCnc(const Program& p);
 std::string writeFanucMacroB(const Program& p);
 

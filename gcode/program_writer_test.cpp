@@ -2,6 +2,8 @@
 // becomes, the counted loop, and that our interpreter runs what the writers emit.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <initializer_list>
 #include <stdexcept>
 
 #include "core/error.hpp"
@@ -23,12 +25,12 @@ Program sample() {
            Spindle{8000},
            Coolant{true},
            Rapid{-130, 0, std::nullopt},
-           Feed{std::nullopt, std::nullopt, -12.1, std::nullopt, 3000},
-           Feed{115, -24, std::nullopt, std::nullopt, 1500},
+           Feed{std::nullopt, std::nullopt, -12.1, 3000},
+           Feed{115, -24, std::nullopt, 1500},
            RotateC{36.5},
            LoopBegin{3, "_pl_load"},
-           Feed{std::nullopt, std::nullopt, std::nullopt, 720, 3600},
-           Feed{std::nullopt, std::nullopt, std::nullopt, 0, 3600},
+           TurnC{720, 3600},
+           TurnC{-720, 3600},
            LoopEnd{},
            Dwell{12.5},
            Coolant{false},
@@ -77,7 +79,7 @@ TEST(ProgramWriter, LinuxCncLines) {
   EXPECT_NE(s.find("(t [test])\n(a header)\nG21 G90 G17 G40 G49 G80 G94\nG10 L2 P6 X0 Y0 Z0 B0 C0\nG59\n"), std::string::npos) << s;
   EXPECT_NE(s.find("G0 B0.000\nT3 M6\nG43 H3\nS8000 M3\nM8\n"), std::string::npos) << s;
   EXPECT_NE(s.find("G1 Z-12.1000 F3000.000\nG1 X115.0000 Y-24.0000 F1500.000\nG0 C36.500\n"), std::string::npos) << s;
-  EXPECT_NE(s.find("#<_pl_load> = 1\no100 while [#<_pl_load> LE 3]\nG1 C720.000 F3600.000\nG1 C0.000 F3600.000\n"
+  EXPECT_NE(s.find("#<_pl_load> = 1\no100 while [#<_pl_load> LE 3]\nG91 G1 C720.000 F3600.000\nG90\nG91 G1 C-720.000 F3600.000\nG90\n"
                    "#<_pl_load> = [#<_pl_load> + 1]\no100 endwhile\nG4 P12.500\nM9\nM5\nT0 M6\nG49\nM2\n"),
             std::string::npos)
       << s;
@@ -87,7 +89,8 @@ TEST(ProgramWriter, LinuxCncLines) {
 TEST(ProgramWriter, FanucLines) {
   const std::string s = writeFanucMacroB(sample());
   EXPECT_EQ(s.rfind("%\nO2002 (T [TEST])\n(A HEADER)\n", 0), 0u) << s;
-  EXPECT_NE(s.find("#101=1\nWHILE [#101 LE 3] DO1\nG1 C720.000 F3600.000\nG1 C0.000 F3600.000\n#101=#101+1\nEND1\n"
+  EXPECT_NE(s.find("#101=1\nWHILE [#101 LE 3] DO1\nG91 G1 C720.000 F3600.000\nG90\nG91 G1 C-720.000 F3600.000\nG90\n"
+                   "#101=#101+1\nEND1\n"
                    "G4 X12.500\nM9\nM5\n"),
             std::string::npos)
       << s;
@@ -128,6 +131,20 @@ TEST(ProgramWriter, RefusesUnbalancedLoopsDeepNestingAndProbingWithoutALog) {
   EXPECT_NO_THROW(writeLinuxCnc(p));
 }
 
+TEST(ProgramWriter, RefusesNumbersThatAreNotFinite) {
+  Program p;
+  p.title = "nan";
+  for (const Op& op : std::initializer_list<Op>{Rapid{NAN, 0, std::nullopt}, Feed{1, 2, INFINITY, 100}, TurnC{360, NAN},
+                                                RotateC{NAN}, ProtectedMove{1, 2, 3, NAN}, Dwell{-INFINITY}}) {
+    EXPECT_FALSE(allFinite(op));
+    p.ops = {op};
+    EXPECT_THROW(writeLinuxCnc(p), std::invalid_argument);
+    EXPECT_THROW(writeFanucMacroB(p), std::invalid_argument);
+  }
+  EXPECT_TRUE(allFinite(Rapid{1, std::nullopt, std::nullopt}));
+  EXPECT_TRUE(allFinite(TurnC{-360, 340}));
+}
+
 TEST(ProgramWriter, OurInterpreterRunsBothDialects) {
   for (auto d : {ProgramDialect::LinuxCnc, ProgramDialect::FanucMacroB}) {
     Counter c;
@@ -137,6 +154,10 @@ TEST(ProgramWriter, OurInterpreterRunsBothDialects) {
     EXPECT_TRUE(r.ended);
     EXPECT_EQ(c.c_feeds, 6);  // 3 x (forward, back)
     EXPECT_EQ(c.feeds, 8);
+    // Incremental turns: +720 and -720 from the index, back where C stood; G90 again after them
+    // (the last absolute move, T0 M6's G49, leaves XYZ where the feeds left them).
+    EXPECT_NEAR(c.at.c_deg, 36.5, 1e-12);
+    EXPECT_NEAR(c.at.xyz_mm.x(), 115, 1e-12);
     EXPECT_EQ(c.dwells, 1);
     EXPECT_EQ(c.tool_changes, 2);
     ASSERT_EQ(c.spindle_rpm.size(), 2u);

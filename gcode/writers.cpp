@@ -1,4 +1,6 @@
 #include <cmath>
+#include <initializer_list>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -13,9 +15,14 @@
 namespace probeloop::gcode {
 namespace {
 
+// A number a program would print as "nan" or "inf": never written.
+double finite(double v) {
+  if (!std::isfinite(v)) throw std::invalid_argument("a non-finite number (" + formatNumber(v) + ") in a program");
+  return v;
+}
 // 4 decimals = 0.1 um, finer than any axis resolution; "-0.0000" never appears.
-std::string n4(double v) { return formatNumber(v, 4); }
-std::string n3(double v) { return formatNumber(v, 3); }
+std::string n4(double v) { return formatNumber(finite(v), 4); }
+std::string n3(double v) { return formatNumber(finite(v), 3); }
 // A constant inside a Fanuc expression: "#5061-[-139.0000]", never "#5061--139.0000".
 std::string macroConst(double v) { return v < 0 ? "[" + n4(v) + "]" : n4(v); }
 
@@ -61,10 +68,10 @@ std::string spindleLine(const Spindle& s) {
   return s.rpm > 0 ? "S" + formatNumber(s.rpm, 0) + " M3\n" : std::string("M5\n");
 }
 std::string coolantLine(const Coolant& c) { return c.on ? "M8\n" : "M9\n"; }
-std::string feedLine(const Feed& f) {
-  std::string s = "G1" + axes(Rapid{f.x, f.y, f.z});
-  if (f.c) s += " C" + n3(*f.c);
-  return s + " F" + n3(f.feed) + "\n";
+std::string feedLine(const Feed& f) { return "G1" + axes(Rapid{f.x, f.y, f.z}) + " F" + n3(f.feed) + "\n"; }
+// Incremental for this line only (n3 always writes the decimal point a Fanuc C word needs).
+std::string turnLines(const TurnC& t) {
+  return "G91 G1 C" + n3(t.delta_deg) + " F" + n3(t.feed_deg_per_min) + "\nG90\n";
 }
 std::string toolChangeLines(const ToolChange& t) {
   return "T" + std::to_string(t.tool) + " M6\n" +
@@ -105,6 +112,7 @@ struct LinuxWriter {
         [&](const Spindle& sp) { out << spindleLine(sp); },
         [&](const Coolant& c) { out << coolantLine(c); },
         [&](const Feed& f) { out << feedLine(f); },
+        [&](const TurnC& t) { out << turnLines(t); },
         [&](const LoopBegin& l) {
           const int lb = label++;
           loops.emplace_back(lb, l.name);
@@ -154,6 +162,7 @@ struct FanucWriter {
         [&](const Spindle& sp) { out << spindleLine(sp); },
         [&](const Coolant& c) { out << coolantLine(c); },
         [&](const Feed& f) { out << feedLine(f); },
+        [&](const TurnC& t) { out << turnLines(t); },
         [&](const LoopBegin& l) {
           // Macro B nests WHILE ... DO1..DO3; #101.. count the loops (#100 is the log's cycle).
           if (++depth > 3) throw std::invalid_argument("loops nested deeper than 3 (Fanuc WHILE ... DO1..DO3)");
@@ -176,10 +185,13 @@ struct FanucWriter {
   }
 };
 
-// A program that probes must open its log; loops must close.
+// A program that probes must open its log; loops must close; every number is finite.
 void checkProgram(const Program& p) {
   int depth = 0;
-  for (const auto& op : p.ops) {
+  for (std::size_t i = 0; i < p.ops.size(); ++i) {
+    const Op& op = p.ops[i];
+    if (!allFinite(op))
+      throw std::invalid_argument(p.title + ": op " + std::to_string(i + 1) + " holds a number that is not finite");
     if (std::holds_alternative<LoopBegin>(op)) ++depth;
     if (std::holds_alternative<LoopEnd>(op) && --depth < 0)
       throw std::invalid_argument(p.title + ": a loop end without a loop begin");
@@ -190,6 +202,33 @@ void checkProgram(const Program& p) {
 }
 
 }  // namespace
+
+bool allFinite(const Op& op) {
+  auto f = [](std::initializer_list<double> v) {
+    for (double x : v)
+      if (!std::isfinite(x)) return false;
+    return true;
+  };
+  auto o = [](const std::optional<double>& v) { return !v || std::isfinite(*v); };
+  return std::visit(Overloaded{
+                        [&](const Comment&) { return true; },
+                        [&](const Rapid& r) { return o(r.x) && o(r.y) && o(r.z); },
+                        [&](const RapidMachineZ& r) { return f({r.z_mm}); },
+                        [&](const RotateC& r) { return f({r.c_deg}); },
+                        [&](const RotateB& r) { return f({r.b_deg}); },
+                        [&](const ToolChange&) { return true; },
+                        [&](const ProtectedMove& m) { return f({m.x, m.y, m.z, m.feed_mm_per_min}); },
+                        [&](const ProbeMove& m) { return f({m.x, m.y, m.z, m.feed_mm_per_min}); },
+                        [&](const Dwell& d) { return f({d.seconds}); },
+                        [&](const Spindle& s) { return f({s.rpm}); },
+                        [&](const Coolant&) { return true; },
+                        [&](const Feed& x) { return o(x.x) && o(x.y) && o(x.z) && f({x.feed}); },
+                        [&](const TurnC& t) { return f({t.delta_deg, t.feed_deg_per_min}); },
+                        [&](const LoopBegin&) { return true; },
+                        [&](const LoopEnd&) { return true; },
+                    },
+                    op);
+}
 
 std::string writeLinuxCnc(const Program& p) {
   checkProgram(p);

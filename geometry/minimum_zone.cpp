@@ -408,6 +408,19 @@ struct LpStep {
   std::vector<int> lower;      // binding at lo (zone, inner)
 };
 
+// CGAL's default (partial filtered Dantzig) pricing can cycle on a degenerate LP and never return:
+// a plane fitted to a dozen points on a 0.1 um grid has more than m + 1 points tied on the
+// zone's boundary after one step (found on a thermal-test-piece Z path). Bland's rule
+// cannot cycle (CGAL manual, QP_solver/cycling.cpp); the LPs here have a few dozen rows.
+const CGAL::Quadratic_program_options& blandPricing() {
+  static const CGAL::Quadratic_program_options options = [] {
+    CGAL::Quadratic_program_options o;
+    o.set_pricing_strategy(CGAL::QP_BLAND);
+    return o;
+  }();
+  return options;
+}
+
 // Exact solution (on the double data) of the linearised problem over all points inside
 // the box |delta_j| <= box, by constraint generation starting from `active`.
 LpStep solveLinearised(const VectorXd& r, const RowMatrix& J, Goal goal, double box,
@@ -442,7 +455,7 @@ LpStep solveLinearised(const VectorXd& r, const RowMatrix& J, Goal goal, double 
     }
     if (goal != Goal::Inner) lp.set_c(hi, 1.0);
     if (goal != Goal::Outer) lp.set_c(lo, -1.0);
-    const auto sol = CGAL::solve_linear_program(lp, CGAL::Gmpzf());
+    const auto sol = CGAL::solve_linear_program(lp, CGAL::Gmpzf(), blandPricing());
     if (!sol.is_optimal())  // bounded box and free hi/lo: always optimal
       throw GeometryError("internal error: linearised Chebyshev LP not optimal");
     std::vector<double> x;

@@ -624,6 +624,31 @@ TEST(MinimumZonePlane, MatchesCgalWidth3AndBruteForce) {
   }
 }
 
+TEST(MinimumZonePlane, TiedSupportPointsDoNotCycleTheLp) {
+  // A Z path of the thermal test piece measured on a 0.1 um-resolution CMM: after the first
+  // step five points tie on the zone, and CGAL's default pricing cycled forever on the next
+  // LP. The zone is the brute force over triples and pairs of edges (0.161538 um by exact
+  // rational arithmetic in Python, run while pinning this bug: points 0, 8 against 4, 11).
+  const Points3 p = {
+      {-79.999946115166011, -26.999934059486538, -12.122770234952206},
+      {-79.999944237221897, -20.999934059488641, -12.12277489641534},
+      {-49.999946115439563, -26.99994344902273, -12.122532905621204},
+      {-49.999944237495448, -20.999943449024833, -12.122537567084338},
+      {-19.999946115588681, -26.99995283863662, -12.122395576290199},
+      {-19.999944237520136, -20.999952838716414, -12.122500237753332},
+      {20.000053884378399, -26.999965358225392, -12.122345803848859},
+      {20.000055762322514, -20.999965358227495, -12.122350465311992},
+      {50.000053884353711, -26.999974747916969, -12.122308474517855},
+      {50.000055762297826, -20.999974747919072, -12.122313135980988},
+      {80.000053884204576, -26.999984137530859, -12.122171145186849},
+      {80.00005576202426, -20.999984137455272, -12.122075806649981},
+  };
+  const auto fit = fitMinimumZone(ElementKind::Plane, p);
+  EXPECT_NEAR(fit.form_mm, 0.161538e-3, 1e-9);
+  EXPECT_NEAR(fit.form_mm, bruteForceFlatness(p), 1e-12);
+  expectNotAbove(ElementKind::Plane, p, fit);
+}
+
 TEST(MinimumZonePlane, HundredThousandPoints) {
   std::mt19937 rng(9);
   std::normal_distribution<double> g(0.0, 0.5e-3);

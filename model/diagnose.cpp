@@ -50,13 +50,13 @@ std::vector<Effect> candidatesFor(const Campaign& c, const ChannelModel& cm, con
     if (isTemperature(name)) {
       add(makeEffect(EffectKind::Static, name));
       add(makeEffect(EffectKind::Lag, name));
-      if (opt.artifact) {
-        Effect e = makeEffect(EffectKind::Expansion, name);
-        e.alpha_um_per_m_K = opt.artifact->alpha_um_per_m_K;
-        if (cm.channel.rfind("EZ0T", 0) == 0) e.length_mm = opt.artifact->height_mm;
-        if (cm.channel.rfind("ER0T", 0) == 0) e.length_mm = opt.artifact->radius_mm;
-        if (e.length_mm > 0 && e.alpha_um_per_m_K > 0) add(e);
-      }
+      if (opt.levers)
+        if (const auto L = opt.levers->lengthFor(cm.channel)) {
+          Effect e = makeEffect(EffectKind::Expansion, name);
+          e.alpha_um_per_m_K = opt.levers->alpha_um_per_m_K;
+          e.length_mm = *L;
+          if (e.alpha_um_per_m_K > 0) add(e);
+        }
     } else if (name == "tool_changes") {
       add(makeEffect(EffectKind::Transient, name));
     } else if (isSpeedInput(name) || endsWith(name, "_on")) {
@@ -70,14 +70,14 @@ std::vector<Effect> candidatesFor(const Campaign& c, const ChannelModel& cm, con
   return out;
 }
 
-std::string physics(const Effect& e) {
+std::string physics(const Effect& e, const std::string& what) {
   const std::string& in = e.input;
   switch (e.kind) {
     case EffectKind::Drift:
       return "no effect in the library explains it; a drift term is only a stand-in: look for a slow source that is not logged";
     case EffectKind::Expansion:
-      return "the artifact's own thermal expansion is missing (alpha L dT with alpha = " + fmt(e.alpha_um_per_m_K, 1) +
-             " um/(m K)); correct it or keep the artifact's temperature constant";
+      return "the " + what + "'s own thermal expansion is missing (alpha L dT with alpha = " + fmt(e.alpha_um_per_m_K, 1) +
+             " um/(m K), L = " + fmt(e.length_mm, 1) + " mm); correct it or keep the " + what + "'s temperature constant";
     case EffectKind::Transient:
       return "the machine settles after each tool change (a cold holder in the warm spindle); model it, or probe after it has settled";
     case EffectKind::Static:
@@ -100,22 +100,22 @@ std::string physics(const Effect& e) {
   return "";
 }
 
-std::string sentence(const Recommendation& r) {
+std::string sentence(const Recommendation& r, const std::string& what) {
   std::string chs;
   for (std::size_t i = 0; i < r.channels.size(); ++i)
     chs += (i == 0 ? "" : i + 1 == r.channels.size() ? " and " : ", ") + r.channels[i].channel;
   const std::string verb = r.channels.size() > 1 ? " residuals follow " : " residual follows ";
   const Effect& e = r.effect;
   switch (e.kind) {
-    case EffectKind::Drift: return chs + verb + "time as a steady drift: " + physics(e) + ".";
-    case EffectKind::Expansion: return chs + verb + "the growth of the artifact with " + e.input + ": " + physics(e) + ".";
+    case EffectKind::Drift: return chs + verb + "time as a steady drift: " + physics(e, what) + ".";
+    case EffectKind::Expansion: return chs + verb + "the growth of the " + what + " with " + e.input + ": " + physics(e, what) + ".";
     case EffectKind::Transient:
       return chs + verb + "each tool change and settle" + (r.channels.size() > 1 ? "" : "s") + " with tau ~" +
-             minutes(*e.tau_s) + ": " + physics(e) + ".";
-    case EffectKind::Static: return chs + verb + e.input + " with no delay: " + physics(e) + ".";
+             minutes(*e.tau_s) + ": " + physics(e, what) + ".";
+    case EffectKind::Static: return chs + verb + e.input + " with no delay: " + physics(e, what) + ".";
     case EffectKind::Lag:
       return chs + verb + (isSpeedInput(e.input) ? e.input + " (its magnitude)" : e.input) + " through a lag of ~" +
-             minutes(*e.tau_s) + ": " + physics(e) + ".";
+             minutes(*e.tau_s) + ": " + physics(e, what) + ".";
     case EffectKind::Offset: break;
   }
   return "";
@@ -127,7 +127,7 @@ std::string command(const Recommendation& r, const DiagnoseOptions& opt) {
   std::string cmd = std::string("probeloop model add ") + kindName(r.effect.kind) + " --model " + opt.model_path + " --channels " + chs;
   if (!r.effect.input.empty()) cmd += " --input " + r.effect.input;
   if (r.effect.hasTimeConstant() && r.effect.tau_s) cmd += " --tau-s " + fmt(*r.effect.tau_s, 0);
-  if (r.effect.kind == EffectKind::Expansion) cmd += " --part " + opt.artifact_path;
+  if (r.effect.kind == EffectKind::Expansion) cmd += " --part " + opt.part_path;
   return cmd;
 }
 
@@ -299,7 +299,7 @@ Diagnosis diagnose(const Campaign& c, const ErrorModel& m, const DiagnoseOptions
       std::sort(taus.begin(), taus.end());
       if (!taus.empty()) g.effect.tau_s = taus[taus.size() / 2];
     }
-    g.sentence = sentence(g);
+    g.sentence = sentence(g, opt.levers ? opt.levers->what : "artifact");
     g.command = command(g, opt);
     d.ranked.push_back(g);
   }

@@ -19,6 +19,7 @@
 // is white (p >= 0.01) and its validation RMS <= 1.5 u), or "unexplained" (no candidate counts
 // but some residual is not white or too large: the library lacks the effect).
 #pragma once
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -67,14 +68,10 @@ struct Recommendation {
   std::string sentence, command;
 };
 
-struct ArtifactLengths {  // the expansion candidates' known lengths (from the artifact file)
-  double alpha_um_per_m_K = 0, height_mm = 0, radius_mm = 0;
-};
-
 struct DiagnoseOptions {
-  std::optional<ArtifactLengths> artifact;
+  std::optional<ExpansionLevers> levers;
   std::string model_path = "model.yaml";  // for the printed command
-  std::string artifact_path;              // ditto (expansion candidates)
+  std::string part_path;                  // ditto (expansion candidates)
 };
 
 struct Diagnosis {

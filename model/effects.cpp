@@ -6,6 +6,12 @@
 
 namespace probeloop::model {
 
+std::optional<double> ExpansionLevers::lengthFor(const std::string& channel) const {
+  const auto it = length_mm.find(channel.substr(0, channel.find('_')));
+  if (it == length_mm.end()) return std::nullopt;
+  return it->second;
+}
+
 double lagStep(double x, double u, double dt_s, double tau_s) {
   // x(t + dt) = u + (x - u) e^{-dt/tau}; expm1 keeps the small-step limit exact.
   return x - (x - u) * -std::expm1(-dt_s / tau_s);

@@ -20,6 +20,7 @@
 // Contract: regressor() is finite for finite inputs; tau > 0; an input column that does not
 // exist is an InputError naming the columns there are.
 #pragma once
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -32,6 +33,17 @@ double lagStep(double x, double u, double dt_s, double tau_s);
 double decayStep(double s, double dt_s, double tau_s);
 // Thermal growth alpha L dT (alpha in um/(m K), L in mm) in um.
 double expansion_um(double alpha_um_per_m_K, double length_mm, double dT_K);
+
+// How the channels of an evaluation read the part's own growth (the expansion effect's known
+// levers, from the part's description: parts::expansionLevers): a channel reads alpha L dT of
+// the part's temperature change, L signed (mm), keyed by the channel's name without its unit
+// suffix (EZ0T, ER0T; EZ, ETTP ...).
+struct ExpansionLevers {
+  double alpha_um_per_m_K = 0;
+  std::map<std::string, double> length_mm;
+  std::string what = "artifact";  // "artifact", "test piece": the diagnosis's sentences name it
+  std::optional<double> lengthFor(const std::string& channel) const;
+};
 
 enum class EffectKind { Offset, Drift, Static, Lag, Transient, Expansion };
 

@@ -30,7 +30,9 @@ Effect readEffect(YamlMap& m) {
     e.alpha_um_per_m_K = m.number("alpha_um_per_m_K");
     if (!(e.alpha_um_per_m_K > 0)) m.fail("alpha_um_per_m_K", "must be > 0 (steel 11.5, aluminium 22, cast iron 11)");
     e.length_mm = m.quantity("length", Dimension::Length);
-    if (!(e.length_mm > 0)) m.fail("length", "must be > 0");
+    // Signed: the lever through which the channel reads the part's growth (a piece cut warm
+    // and measured cold reads smaller, so its diameter's lever is negative).
+    if (!(e.length_mm != 0)) m.fail("length", "must not be 0 (signed lever of the part's growth, mm)");
   }
   e.just_added = m.booleanOr("just_added", false);
   m.finish();

@@ -1,5 +1,7 @@
 #include "parts/machine.hpp"
 
+#include "core/units.hpp"
+
 #include <algorithm>
 #include <cctype>
 #include <stdexcept>
@@ -53,6 +55,15 @@ RotaryAxis readRotary(YamlMap m, bool with_sense) {
 }
 
 }  // namespace
+
+Eigen::Vector2d turnedByTable(const Eigen::Vector2d& v, double c_deg, bool positive_is_clockwise) {
+  const double a = degToRad(tableTurnSign(positive_is_clockwise) * c_deg);
+  return {std::cos(a) * v.x() - std::sin(a) * v.y(), std::sin(a) * v.x() + std::cos(a) * v.y()};
+}
+
+Eigen::Vector2d unturnedByTable(const Eigen::Vector2d& v, double c_deg, bool positive_is_clockwise) {
+  return turnedByTable(v, -c_deg, positive_is_clockwise);
+}
 
 std::array<bool, 3> workpieceSideAxes(const std::string& code) {
   std::array<bool, 3> side{false, false, false};

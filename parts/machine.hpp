@@ -71,4 +71,12 @@ std::array<bool, 3> workpieceSideAxes(const std::string& iso10791_code);  // std
 
 Machine loadMachine(const std::string& path);
 
+// How the table turns things (docs/conventions.md): a part-frame direction at angle th (deg,
+// about the C axis) shows in the machine at th + tableTurnSign(..) * C; on a C' axis (table
+// on the workpiece side, +C clockwise seen from +Z) the sign is -1.
+inline double tableTurnSign(bool positive_is_clockwise) { return positive_is_clockwise ? -1.0 : 1.0; }
+// A part-frame XY vector (from the C axis) as the machine sees it with the table at C, and back.
+Eigen::Vector2d turnedByTable(const Eigen::Vector2d& v, double c_deg, bool positive_is_clockwise);
+Eigen::Vector2d unturnedByTable(const Eigen::Vector2d& v, double c_deg, bool positive_is_clockwise);
+
 }  // namespace probeloop::parts

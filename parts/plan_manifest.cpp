@@ -108,8 +108,6 @@ std::string genericManifestJson(const PlanManifest& m) {
     const auto& t = m.ttp;
     j["thermal_test_piece"] = {{"z_paths", t.z_paths},
                                {"facets_per_segment", t.facets_per_segment},
-                               {"facet_apothem_mm", t.facet_apothem_mm},
-                               {"test_tool_radius_mm", t.test_tool_radius_mm},
                                {"eq_7_10", {{"alpha_um_per_m_K", t.eq_7_10_alpha_um_per_m_K},
                                             {"alpha_u_um_per_m_K", t.alpha_u_um_per_m_K},
                                             {"radius_mm", t.eq_7_10_radius_mm}}},
@@ -221,8 +219,6 @@ void readGeneric(const ordered_json& j, PlanManifest& m) {
     auto& c = m.ttp;
     c.z_paths = t.at("z_paths");
     c.facets_per_segment = t.at("facets_per_segment");
-    c.facet_apothem_mm = t.at("facet_apothem_mm");
-    c.test_tool_radius_mm = t.at("test_tool_radius_mm");
     c.eq_7_10_alpha_um_per_m_K = t.at("eq_7_10").at("alpha_um_per_m_K");
     c.alpha_u_um_per_m_K = t.at("eq_7_10").at("alpha_u_um_per_m_K");
     c.eq_7_10_radius_mm = t.at("eq_7_10").at("radius_mm");
@@ -232,6 +228,17 @@ void readGeneric(const ordered_json& j, PlanManifest& m) {
     c.on_machine_repeatability_um = t.at("on_machine").at("repeatability_um");
     c.on_machine_temperature_change_K = t.at("on_machine").at("temperature_change_K");
     c.cmm_plan = t.at("cmm_plan");
+    // Divisors and half-widths of the evaluation: refused here rather than a NaN later.
+    auto need = [&](bool ok, const std::string& what) {
+      if (!ok) throw InputError(path, 0, "thermal_test_piece." + what);
+    };
+    need(c.z_paths >= 2 && c.facets_per_segment >= 2, "z_paths, facets_per_segment: expected at least 2 each");
+    need(c.eq_7_10_alpha_um_per_m_K > 0 && c.eq_7_10_radius_mm > 0, "eq_7_10: alpha and radius must be positive");
+    need(c.alpha_u_um_per_m_K >= 0, "eq_7_10.alpha_u_um_per_m_K: must not be negative");
+    need(c.cmm.mpe_constant_um >= 0 && c.cmm.mpe_length_mm >= 0 && c.cmm.temperature_half_width_K >= 0,
+         "cmm: MPE terms and the temperature half-width must not be negative");
+    need(c.on_machine_repeatability_um >= 0 && c.on_machine_temperature_change_K >= 0,
+         "on_machine: repeatability and temperature change must not be negative");
   }
   for (const auto& f : j.at("features")) {
     ManifestFeature x;

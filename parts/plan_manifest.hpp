@@ -73,8 +73,6 @@ struct ManifestCut {
 // What the thermal-test-piece evaluation needs beyond the features (seed 004 Ch. 7).
 struct ThermalTestPieceConstants {
   int z_paths = 0, facets_per_segment = 0;
-  double facet_apothem_mm = 0;
-  double test_tool_radius_mm = 0;
   double eq_7_10_alpha_um_per_m_K = 0, alpha_u_um_per_m_K = 0, eq_7_10_radius_mm = 0;
   CmmSpec cmm;
   double on_machine_repeatability_um = 0, on_machine_temperature_change_K = 0;

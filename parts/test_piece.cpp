@@ -52,9 +52,8 @@ TestPiece fromWorkpiece(Workpiece w) {
 
 }  // namespace
 
-const std::vector<TestPieceKind>& testPieceKinds() {
-  static const std::vector<TestPieceKind> kinds{
-      {"sphere_artifact", true}, {"thermal_test_piece", true}, {"workpiece", false}};
+const std::vector<std::string>& testPieceKinds() {
+  static const std::vector<std::string> kinds{"sphere_artifact", "thermal_test_piece", "workpiece"};
   return kinds;
 }
 
@@ -64,8 +63,32 @@ TestPiece loadTestPiece(const std::string& path) {
   if (kind == "thermal_test_piece") return fromThermalTestPiece(loadThermalTestPiece(path));
   if (kind == "workpiece") return fromWorkpiece(loadWorkpiece(path));
   std::string list;
-  for (const auto& k : testPieceKinds()) list += (list.empty() ? "" : ", ") + k.kind;
+  for (const auto& k : testPieceKinds()) list += (list.empty() ? "" : ", ") + k;
   throw InputError(path, 1, "kind: '" + kind + "' is not a kind of test piece probeloop knows (" + list + ")");
+}
+
+model::ExpansionLevers expansionLevers(const TestPiece& piece) {
+  model::ExpansionLevers out;
+  if (const auto* a = piece.sphereArtifact()) {
+    if (!(a->alpha_um_per_m_K > 0))
+      throw InputError(piece.file, 0, "uncertainty.alpha_um_per_m_K: the expansion candidates need the artifact's expansion coefficient");
+    out.alpha_um_per_m_K = a->alpha_um_per_m_K;
+    out.length_mm = {{"EZ0T", a->centreHeightAboveTable() + a->sphereRadius()}, {"ER0T", a->radius_from_axis_mm}};
+    out.what = "artifact";
+    return out;
+  }
+  if (const auto* t = piece.thermalTestPiece()) {
+    if (!(t->material.alpha_um_per_m_K > 0))
+      throw InputError(piece.file, 0, "blank.material.alpha_um_per_m_K: the expansion candidates need the piece's expansion coefficient");
+    // Table -> Z path floor: the adapter and the washers (same alloy, L1998) and the piece
+    // below the path all follow the piece's temperature.
+    const double path_height = t->supportHeight() + t->finishedHeight() + t->cuttingZ();
+    out.alpha_um_per_m_K = t->material.alpha_um_per_m_K;
+    out.length_mm = {{"EZ", path_height}, {"ETTP", -2 * t->facet_apothem_mm}};
+    out.what = "test piece";
+    return out;
+  }
+  throw InputError(piece.file, 1, "kind: " + piece.kind + " has no evaluation, so no expansion levers: give --alpha-um-per-m-K and --length-mm");
 }
 
 std::vector<EvaluationRule> sphereArtifactEvaluation() {
@@ -92,7 +115,9 @@ std::vector<EvaluationRule> thermalTestPieceEvaluation() {
        "Z paths of cycle i and of the reference cycle"},
       {"ETTP_um", "[l_X(ti) - l_X(t0) + l_Y(ti) - l_Y(t0)] / 2, l = d_1 + d_2",
        "seed 004 Eq. 7.3 (diametral); Eq. 7.9, half of it, is reported beside it", facets},
-      {"dT_K", "E / (alpha R)", "seed 004 Eq. 7.10 (alpha, R from the description)", "E_TTP (radial, Eq. 7.9 form)"},
+      {"dT_K", "-E_TTP,7.9 / (alpha R)",
+       "seed 004 Eq. 7.10 (alpha, R from the description); minus: a piece cut warm is smaller at 20 C (docs/thermal-test-piece.md §4)",
+       "E_TTP (radial, Eq. 7.9 form)"},
   };
 }
 

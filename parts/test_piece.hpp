@@ -19,6 +19,7 @@
 #include <variant>
 #include <vector>
 
+#include "model/effects.hpp"
 #include "parts/feature.hpp"
 #include "parts/sphere_artifact.hpp"
 #include "parts/thermal_test_piece.hpp"
@@ -39,13 +40,18 @@ struct TestPiece {
 
 TestPiece loadTestPiece(const std::string& path);
 
-// The kinds loadTestPiece knows, and for each whether it has a planner and an evaluation
-// (a plain workpiece has neither: it stands on the simulated table for a program of one's own).
-struct TestPieceKind {
-  std::string kind;
-  bool plannable = false;
-};
-const std::vector<TestPieceKind>& testPieceKinds();
+// The kinds loadTestPiece knows (a plain workpiece has no planner and no evaluation: it
+// stands on the simulated table for a program of one's own).
+const std::vector<std::string>& testPieceKinds();
+
+// How each evaluated channel of the kind reads the part's own thermal expansion: alpha and,
+// per channel (the name without its unit suffix), the signed lever L of alpha L dT (mm).
+// Sphere artifact: EZ0T the centre height + the ball radius, ER0T d/2 (docs/simulator.md §3).
+// Thermal test piece: EZ the Z paths' height above the table (the piece and its adapter of
+// the same alloy grow: a path cut warm lies deeper at 20 °C), ETTP -2 x the facets' apothem
+// (Eq. 7.3: a piece cut warm is smaller when measured cold). InputError when the description
+// lacks alpha or the kind has no evaluation.
+model::ExpansionLevers expansionLevers(const TestPiece& piece);
 
 // The evaluation rules of each kind (also written into the plan manifest).
 std::vector<EvaluationRule> sphereArtifactEvaluation();

@@ -378,7 +378,11 @@ std::vector<NominalFeature> nominalFeatures(const ThermalTestPiece& t) {
     f.half_v_mm = hv;
     return f;
   };
-  out.push_back(plane("TOP", "datum_top", "datum", 0, Vector3d::Zero(), Vector3d::UnitZ(), Vector3d::UnitX(), R, R));
+  // The finished top is no wider than the band that reaches z = 0.
+  double r_top = R;
+  for (const auto& band : t.bands)
+    if (band.z_to_mm >= -1e-9) r_top = band.diameter_mm / 2;
+  out.push_back(plane("TOP", "datum_top", "datum", 0, Vector3d::Zero(), Vector3d::UnitZ(), Vector3d::UnitX(), r_top, r_top));
   out.push_back(plane("FLANK_P", "datum_flank", "datum", 0, Vector3d(0, t.x_notch_width_mm / 2, floor / 2), -Vector3d::UnitY(),
                       Vector3d::UnitX(), flank_x, -floor / 2));
   out.push_back(plane("FLANK_N", "datum_flank", "datum", 0, Vector3d(0, -t.x_notch_width_mm / 2, floor / 2), Vector3d::UnitY(),
@@ -457,6 +461,7 @@ Workpiece thermalTestPieceWorkpiece(const ThermalTestPiece& t) {
   }
   w.obstacles.push_back({Vector2d::Zero(), t.adapter_diameter_mm / 2, -H - t.washer_thickness_mm - t.adapter_height_mm,
                          -H - t.washer_thickness_mm, "adapter"});
+  w.support_height_mm = t.supportHeight();
   w.material = t.material;
   w.tools = t.tools;
   w.cmm = t.cmm;

@@ -44,75 +44,78 @@ struct TtpLoadPhase {
 };
 
 struct TtpProbing {
-  double feed_mm_per_min = 200;        // seed 004 L2145
-  double positioning_feed_mm_per_min = 1000;
-  double approach_mm = 3, overtravel_mm = 2, clearance_mm = 10;
+  double feed_mm_per_min = 0;        // seed 004 L2145
+  double positioning_feed_mm_per_min = 0;
+  double approach_mm = 0, overtravel_mm = 0, clearance_mm = 0;
 };
 
+// Every field is read from the description (every key is required: docs/formats.md); the
+// values are in parts/thermal_test_piece.yaml, not here.
 struct ThermalTestPiece {
   std::string file, name;
   // Blank (seed 004 L1990) and fixture (L1998).
-  double blank_diameter_mm = 203, blank_height_mm = 25;
+  double blank_diameter_mm = 0, blank_height_mm = 0;
   WorkpieceMaterial material;
   // Three blind threaded holes from below, symmetric to the part's X axis; the bolts come
   // through the adapter, so nothing of the clamping stands above the part (our choice).
-  int bolt_holes = 3;
-  double bolt_circle_diameter_mm = 140, bolt_first_angle_deg = 180;
-  double bolt_hole_diameter_mm = 8.5, bolt_hole_depth_mm = 12;
-  double adapter_diameter_mm = 150, adapter_height_mm = 40;
-  double washer_diameter_mm = 20, washer_thickness_mm = 3;  // fine-ground, under the bolt holes
+  int bolt_holes = 0;
+  double bolt_circle_diameter_mm = 0, bolt_first_angle_deg = 0;
+  double bolt_hole_diameter_mm = 0, bolt_hole_depth_mm = 0;
+  double adapter_diameter_mm = 0, adapter_height_mm = 0;
+  double washer_diameter_mm = 0, washer_thickness_mm = 0;  // fine-ground, under the bolt holes
   // Pre-machining (L2002-L2018).
-  double pre_spindle_rpm = 6000;
-  double face_depth_mm = 1, face_stepover_mm = 12, face_feed_mm_per_min = 1500;
-  int face_tool = 1;
+  double pre_spindle_rpm = 0;
+  double face_depth_mm = 0, face_stepover_mm = 0, face_feed_mm_per_min = 0;
+  int face_tool = 0;
   std::vector<TtpBand> bands;
-  int band_tool = 1;
-  double band_feed_mm_per_min = 600;  // at the cutting edge
-  int mark_tool = 4;
-  Eigen::Vector2d mark_from_mm{40, 70}, mark_to_mm{40, 85};
-  double mark_depth_mm = 0.2;
-  int y_notch_tool = 2;
-  double y_notch_width_mm = 10, y_notch_depth_mm = 13, y_notch_step_mm = 5;
-  int x_notch_tool = 1;
-  double x_notch_width_mm = 110, x_notch_depth_mm = 12, x_notch_step_mm = 4, x_notch_allowance_mm = 0.3;
-  int facets_per_segment = 9;
-  double facet_pitch_deg = 6, facet_apothem_mm = 97.5, facet_allowance_mm = 0.1, first_normal_angle_deg = 36.5;
-  int facet_pre_tool = 1;
-  double pre_feed_mm_per_min = 1500;  // notches and facets
+  int band_tool = 0;
+  double band_feed_mm_per_min = 0;  // at the cutting edge
+  int mark_tool = 0;
+  Eigen::Vector2d mark_from_mm = Eigen::Vector2d::Zero(), mark_to_mm = Eigen::Vector2d::Zero();
+  double mark_depth_mm = 0;
+  int y_notch_tool = 0;
+  double y_notch_width_mm = 0, y_notch_depth_mm = 0, y_notch_step_mm = 0;
+  int x_notch_tool = 0;
+  double x_notch_width_mm = 0, x_notch_depth_mm = 0, x_notch_step_mm = 0, x_notch_allowance_mm = 0;
+  int facets_per_segment = 0;
+  double facet_pitch_deg = 0, facet_apothem_mm = 0, facet_allowance_mm = 0, first_normal_angle_deg = 0;
+  int facet_pre_tool = 0;
+  double pre_feed_mm_per_min = 0;  // notches and facets
   // The test (L2022-L2047).
-  int test_tool = 3;
-  double cut_depth_mm = 0.1;                 // Z paths below the notch floor; facets from their allowance
-  double test_feed_mm_per_min = 1500, test_spindle_rpm = 8000;
-  int z_paths = 9;
-  double z_path_pitch_mm = 12;
-  double z_path_x_from_mm = -115, z_path_x_to_mm = 115;  // the whole length, from outside to outside
-  double facet_path_half_length_mm = 40;     // each facet cut runs +-this along its chord
+  int test_tool = 0;
+  double cut_depth_mm = 0;                 // Z paths below the notch floor; facets from their allowance
+  double test_feed_mm_per_min = 0, test_spindle_rpm = 0;
+  int z_paths = 0;
+  double z_path_pitch_mm = 0;
+  double z_path_x_from_mm = 0, z_path_x_to_mm = 0;  // the whole length, from outside to outside
+  double facet_path_half_length_mm = 0;     // each facet cut runs +-this along its chord
   std::vector<int> order;                    // path and facet number per cycle; [0] = reference
-  Eigen::Vector2d waiting_position_mm{-130, 0};  // part frame, at the cutting height
-  double ring_radius_mm = 122;               // moves below the top go around the part on this circle
+  Eigen::Vector2d waiting_position_mm = Eigen::Vector2d::Zero();  // part frame, at the cutting height
+  double ring_radius_mm = 0;               // moves below the top go around the part on this circle
   std::vector<TtpLoadPhase> load;
-  double wait_s = 3600;                      // waiting time between two cutting cycles (L2034)
-  double c_turn_move_s = 10;                 // the C load is commanded as G91 C moves of this duration
-  bool pre_machining_coolant = true;         // all milling is wet (L2000) ...
+  double wait_s = 0;                      // waiting time between two cutting cycles (L2034)
+  double c_turn_move_s = 0;                 // the C load: alternating incremental C feed moves of this duration
+  bool pre_machining_coolant = false;         // all milling is wet (L2000) ...
   bool test_coolant = false;                 // ... but a dry test gets MWF only in pre-machining
   // Inspection (L2053-L2145).
   TtpProbing probing;
-  std::vector<double> facet_points_across_mm{-3, 0, 3};  // along the facet, from its centre
-  std::vector<double> facet_points_heights_mm{-3, -9};   // part-frame z
-  std::vector<double> z_path_points_along_mm{-85, -50, -20, 20, 50, 85};  // x
-  std::vector<double> z_path_points_across_mm{-3, 3};    // from the path's centre line
-  double datum_circle_z_mm = -16.5;          // on the band the origin circle is fitted to
-  int datum_circle_points = 12;
-  double datum_band_diameter_mm = 201;
+  std::vector<double> facet_points_across_mm;  // along the facet, from its centre
+  std::vector<double> facet_points_heights_mm;   // part-frame z
+  std::vector<double> z_path_points_along_mm;  // x
+  std::vector<double> z_path_points_across_mm;    // from the path's centre line
+  double datum_circle_z_mm = 0;          // on the band the origin circle is fitted to
+  int datum_circle_points = 0;
+  double datum_band_diameter_mm = 0;
   CmmSpec cmm;                               // MPE 1.2 um + L/400 (L2145), 20 +- 0.3 °C
-  double on_machine_repeatability_um = 1.0;  // machine repeatability added to the probe's (L2145)
-  double on_machine_temperature_change_K = 0.1;  // part temperature change between compared features
+  double on_machine_repeatability_um = 0;  // machine repeatability added to the probe's (L2145)
+  double on_machine_temperature_change_K = 0;  // part temperature change between compared features
   // Evaluation constants (Eq. 7.10, L2177).
-  double eq_7_10_alpha_um_per_m_K = 22, eq_7_10_radius_mm = 97.5;
-  double alpha_u_um_per_m_K = 1.0;           // standard uncertainty of alpha (budget of Eq. 7.10)
+  double eq_7_10_alpha_um_per_m_K = 0, eq_7_10_radius_mm = 0;
+  double alpha_u_um_per_m_K = 0;           // standard uncertainty of alpha (budget of Eq. 7.10)
   std::vector<CuttingTool> tools;
 
   double finishedHeight() const { return blank_height_mm - face_depth_mm; }
+  double supportHeight() const { return adapter_height_mm + washer_thickness_mm; }  // table -> piece
   double notchFloorZ() const { return -x_notch_depth_mm; }
   double cuttingZ() const { return -x_notch_depth_mm - cut_depth_mm; }  // tool tip during the test
   int cycles() const { return static_cast<int>(order.size()); }

@@ -186,7 +186,7 @@ TEST(ThermalTestPiece, ThesisNumbersOfEquations76And710AndTable72) {
   // Eq. 7.10 (L2177): 8 K of a cast-iron table (11 um/(m K)) at R = 160 mm is 14.1 um
   // (notes/seed004.md §5.5), and back.
   EXPECT_NEAR(temperatureEquivalentEq710_K(14.1, 11, 160), 8.0, 0.02);
-  EXPECT_NEAR(8.0 * 11 * 0.160, 14.08, 1e-12);
+  EXPECT_NEAR(temperatureEquivalentEq710_K(14.08, 11, 160), 8.0, 1e-12);
   // The test piece at R = 97.5 mm, aluminium 22 um/(m K): 8 K is 17.16 um.
   EXPECT_NEAR(temperatureEquivalentEq710_K(17.16, 22, 97.5), 8.0, 1e-3);
   // Table 7.2 (L2234): E_Y spans 15.8 -> 0.5 um (1 h) and 31 -> 2.9 um (8 h): the abstract's
@@ -256,6 +256,21 @@ TEST(TestPieces, EveryKindLoadsIntoOneModel) {
   }
 }
 
+TEST(TestPieces, ExpansionLeversFollowTheGeometry) {
+  // Derived by hand: a Z path cut warm at a fixed machine height lies alpha dT h deeper at
+  // 20 C, h its height above the table (40 mm adapter + 3 mm washers + 24 mm piece - 12.1 mm);
+  // Eq. 7.3 of a piece cut warm reads -2 a alpha dT (a = 97.5 mm).
+  const auto ttp = expansionLevers(loadTestPiece(shipped()));
+  EXPECT_NEAR(ttp.alpha_um_per_m_K, 23.4, 1e-12);
+  EXPECT_NEAR(*ttp.lengthFor("EZ_um"), 40 + 3 + 24 - 12.1, 1e-9);
+  EXPECT_NEAR(*ttp.lengthFor("ETTP_um"), -195, 1e-9);
+  EXPECT_FALSE(ttp.lengthFor("EX_um").has_value());  // a uniform growth moves X1 and X2 alike
+  const auto sphere = expansionLevers(loadTestPiece(std::string(PROBELOOP_SOURCE_DIR) + "/parts/sphere_artifact.yaml"));
+  EXPECT_NEAR(*sphere.lengthFor("EZ0T_um"), 60 + 15 + 15, 1e-9);  // stem + ball diameter (centre + R)
+  EXPECT_NEAR(*sphere.lengthFor("ER0T_um"), 160, 1e-9);
+  EXPECT_THROW(expansionLevers(loadTestPiece(std::string(PROBELOOP_SOURCE_DIR) + "/examples/workpiece_block.yaml")), InputError);
+}
+
 TEST(PlanManifest, GenericKindRoundTrips) {
   PlanManifest m;
   m.file = "plan.json";
@@ -268,6 +283,9 @@ TEST(PlanManifest, GenericKindRoundTrips) {
   m.material_name = "AlMgSi1";
   m.material_alpha_um_per_m_K = 23.4;
   m.ttp.z_paths = 9;
+  m.ttp.facets_per_segment = 9;
+  m.ttp.eq_7_10_alpha_um_per_m_K = 22;
+  m.ttp.eq_7_10_radius_mm = 97.5;
   m.ttp.cmm.mpe_constant_um = 1.2;
   m.ttp.cmm_plan = "cmm_points.csv";
   const auto t = loadThermalTestPiece(shipped());

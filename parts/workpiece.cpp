@@ -31,7 +31,8 @@ std::pair<double, double> range(YamlMap& m, const std::string& key) {
 WorkpieceMaterial readMaterial(YamlMap m) {
   WorkpieceMaterial out;
   out.name = m.string("name");
-  out.alpha_per_K = m.number("alpha_um_per_m_K") * 1e-6;
+  out.alpha_um_per_m_K = m.number("alpha_um_per_m_K");
+  out.alpha_per_K = out.alpha_um_per_m_K * 1e-6;
   out.specific_cutting_force_N_per_mm2 = m.number("specific_cutting_force_N_per_mm2");
   out.radial_force_ratio = m.numberOr("radial_force_ratio", 0.4);
   if (!(out.alpha_per_K >= 0 && out.alpha_per_K < 1e-4))

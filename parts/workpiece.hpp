@@ -32,6 +32,7 @@ struct WorkpieceMaterial {
   double alpha_per_K = 0;                   // nominal expansion coefficient
   double specific_cutting_force_N_per_mm2 = 0;  // k_c: cutting power = k_c x removal rate
   double radial_force_ratio = 0;            // F_radial / F_tangential
+  double alpha_um_per_m_K = 0;              // alpha_per_K as written, for outputs (23.4, not 23.399999999999995)
 };
 
 struct CmmSpec {
@@ -60,6 +61,10 @@ struct Workpiece {
   std::vector<VerticalCylinder> holes;      // removed before the first cut (through holes, counterbores)
   std::vector<VerticalCylinder> obstacles;  // clamps, bolt heads, adapter: never to be touched
   Eigen::Vector3d frame_origin_mm = Eigen::Vector3d::Zero();  // part frame origin, machine coords at C = 0
+  // Height of the support under the part that shares its temperature and expansion
+  // coefficient (an adapter and washers of the same alloy): a warm support lifts the part by
+  // alpha dT support_height. 0 = the part sits on the table (kind: workpiece).
+  double support_height_mm = 0;
   WorkpieceMaterial material;
   std::vector<CuttingTool> tools;
   CmmSpec cmm;

@@ -21,18 +21,32 @@ double round3(double v) {
   return r == 0 ? 0.0 : r;
 }
 
+double rotaryIndexSeconds(double delta_deg, const parts::RotaryAxis& ax) {
+  if (delta_deg == 0) return 0;
+  return std::fabs(delta_deg) / (ax.max_speed_rpm * 360.0) * 60.0;
+}
+
+double rapidSeconds(const parts::Machine& m, const Vector3d& d, double db, double dc) {
+  return std::max({d.cwiseAbs().maxCoeff() / m.rapid_feed_mm_per_min * 60.0, rotaryIndexSeconds(dc, m.c),
+                   m.b.present ? rotaryIndexSeconds(db, m.b) : 0.0});
+}
+
+double linearFeedSeconds(double path_mm, double F) { return path_mm / F * 60.0; }
+double rotaryFeedSeconds(double delta_deg, double F) { return std::fabs(delta_deg) / F * 60.0; }
+
+void NotedProgram::add(gcode::Op op, OpNote note) {
+  if (!gcode::allFinite(op))
+    throw GeometryError(file + ": " + note.where + ": a coordinate, feed or time that is not a finite number " +
+                        "(the description's layout gives none here)");
+  program.ops.push_back(std::move(op));
+  notes.push_back(std::move(note));
+}
+
 namespace {
 template <class... Ts>
 struct Overloaded : Ts... { using Ts::operator()...; };
 template <class... Ts>
 Overloaded(Ts...) -> Overloaded<Ts...>;
-
-// Seconds a rotary axis needs to index by `delta` at its positioning speed (the simulator's
-// rotaryTime).
-double rotaryTime(double delta_deg, const parts::RotaryAxis& ax) {
-  if (delta_deg == 0) return 0;
-  return std::fabs(delta_deg) / (ax.max_speed_rpm * 360.0) * 60.0;
-}
 }  // namespace
 
 ProgramWalker::ProgramWalker(const parts::Machine& m, std::vector<WalkerTool> tools) : m_(m), tools_(std::move(tools)) {
@@ -65,13 +79,20 @@ void ProgramWalker::checkTravel(const Vector3d& g, const OpNote& note, const cha
   const parts::LinearAxis* ax[3] = {&m_.x, &m_.y, &m_.z};
   const char* names = "XYZ";
   for (int i = 0; i < 3; ++i)
-    if (g(i) < ax[i]->min_mm - 1e-9 || g(i) > ax[i]->max_mm + 1e-9) {
+    if (!(g(i) >= ax[i]->min_mm - 1e-9 && g(i) <= ax[i]->max_mm + 1e-9)) {  // NaN fails too
       std::ostringstream s;
       s << what << " needs " << names[i] << " = " << formatNumber(g(i), 3) << " mm (gauge line = tip + tool length "
         << formatNumber(tool_.length_mm, 3) << " mm), outside the " << names[i] << " travel [" << formatNumber(ax[i]->min_mm, 3)
         << ", " << formatNumber(ax[i]->max_mm, 3) << "] of " << m_.file;
       fail(note, s.str());
     }
+}
+
+void ProgramWalker::checkCTravel(double c, const OpNote& note, const char* what) const {
+  if (!m_.c.present) fail(note, std::string(what) + " on a machine without a C axis (" + m_.file + ")");
+  if (!std::isfinite(c) || (!m_.c.continuous && !(c >= m_.c.min_deg - 1e-9 && c <= m_.c.max_deg + 1e-9)))
+    fail(note, std::string(what) + " needs C = " + formatNumber(c, 3) + " deg, outside the C travel [" +
+                   formatNumber(m_.c.min_deg, 3) + ", " + formatNumber(m_.c.max_deg, 3) + "] of " + m_.file);
 }
 
 void ProgramWalker::checkLinearFeed(double F, const OpNote& note, const char* what) const {
@@ -82,11 +103,12 @@ void ProgramWalker::checkLinearFeed(double F, const OpNote& note, const char* wh
                    formatNumber(fmax, 3) + " mm/min (slowest axis, " + m_.file + ")");
 }
 
-void ProgramWalker::motion(const char* what, const Vector3d& to_tip, double to_c, const OpNote& note) const {
+void ProgramWalker::motion(MotionKind kind, const char* what, const Vector3d& to_tip, double to_c, const OpNote& note) const {
   if (!check_) return;
   Motion mo;
   mo.program = program_;
   mo.note = &note;
+  mo.kind = kind;
   mo.what = what;
   mo.from_tip = tip();
   mo.to_tip = to_tip;
@@ -125,6 +147,7 @@ void ProgramWalker::run(const NotedProgram& p, const OpCallback& on_op) {
 }
 
 void ProgramWalker::step(const gcode::Op& op, const OpNote& note) {
+  if (!gcode::allFinite(op)) fail(note, "a coordinate, feed or time that is not a finite number");
   const double L = tool_.length_mm;
   std::visit(
       Overloaded{
@@ -138,8 +161,8 @@ void ProgramWalker::step(const gcode::Op& op, const OpNote& note) {
             if (r.z) to.z() = *r.z;
             const Vector3d g = to + Vector3d(0, 0, L);
             checkTravel(g, note, "rapid move");
-            motion("rapid move", to, c_, note);
-            const double dt = (g - gauge_).cwiseAbs().maxCoeff() / m_.rapid_feed_mm_per_min * 60.0;
+            motion(MotionKind::Rapid, "rapid move", to, c_, note);
+            const double dt = rapidSeconds(m_, g - gauge_);
             times_.rapid_s += dt;
             t_ += dt;
             gauge_ = g;
@@ -147,33 +170,34 @@ void ProgramWalker::step(const gcode::Op& op, const OpNote& note) {
           [&](const gcode::RapidMachineZ& r) {
             const Vector3d g(gauge_.x(), gauge_.y(), r.z_mm);
             checkTravel(g, note, "retract to the tool-change height");
-            motion("retract to the tool-change height", g - Vector3d(0, 0, L), c_, note);
-            const double dt = std::fabs(g.z() - gauge_.z()) / m_.rapid_feed_mm_per_min * 60.0;
+            motion(MotionKind::MachineZ, "retract to the tool-change height", g - Vector3d(0, 0, L), c_, note);
+            const double dt = rapidSeconds(m_, g - gauge_);
             times_.rapid_s += dt;
             t_ += dt;
             gauge_ = g;
           },
           [&](const gcode::RotateC& r) {
-            if (!m_.c.present) fail(note, "C move on a machine without a C axis (" + m_.file + ")");
-            if (!m_.c.continuous && (r.c_deg < m_.c.min_deg - 1e-9 || r.c_deg > m_.c.max_deg + 1e-9))
-              fail(note, "C = " + formatNumber(r.c_deg, 3) + " deg is outside the C travel of " + m_.file);
-            motion("C index", tip(), r.c_deg, note);
-            const double dt = rotaryTime(r.c_deg - c_, m_.c);
+            checkCTravel(r.c_deg, note, "C index");
+            motion(MotionKind::CIndex, "C index", tip(), r.c_deg, note);
+            const double dt = rotaryIndexSeconds(r.c_deg - c_, m_.c);
             times_.rotary_index_s += dt;
             t_ += dt;
             c_ = r.c_deg;
           },
           [&](const gcode::RotateB& r) {
             if (!m_.b.present) fail(note, "B move on a machine without a B axis (" + m_.file + ")");
-            if (!m_.b.continuous && (r.b_deg < m_.b.min_deg - 1e-9 || r.b_deg > m_.b.max_deg + 1e-9))
+            if (!m_.b.continuous && !(r.b_deg >= m_.b.min_deg - 1e-9 && r.b_deg <= m_.b.max_deg + 1e-9))
               fail(note, "B = " + formatNumber(r.b_deg, 3) + " deg is outside the B travel of " + m_.file);
-            const double dt = rotaryTime(r.b_deg - b_, m_.b);
+            const double dt = rotaryIndexSeconds(r.b_deg - b_, m_.b);
             times_.rotary_index_s += dt;
             t_ += dt;
             b_ = r.b_deg;
           },
           [&](const gcode::ToolChange& tc) {
             if (spindle_rpm_ != 0) fail(note, "tool change T" + std::to_string(tc.tool) + " with the spindle turning (M5 first)");
+            if (std::fabs(gauge_.z() - m_.tool_change.z_mm) > 1e-9)
+              fail(note, "tool change T" + std::to_string(tc.tool) + " with the gauge line at Z " + formatNumber(gauge_.z(), 3) +
+                             " mm, not at the tool-change height " + formatNumber(m_.tool_change.z_mm, 3) + " mm (G53 first)");
             const WalkerTool& t = toolFor(tc.tool, note);
             if (tc.apply_length_offset == (t.number == m_.tool_change.empty_tool))
               fail(note, "T" + std::to_string(tc.tool) + (tc.apply_length_offset ? ": the empty spindle has no length offset (G49)"
@@ -200,33 +224,31 @@ void ProgramWalker::step(const gcode::Op& op, const OpNote& note) {
             if (f.y) to.y() = *f.y;
             if (f.z) to.z() = *f.z;
             const Vector3d g = to + Vector3d(0, 0, L);
-            const double len = (g - gauge_).norm();
-            const double c_to = f.c ? *f.c : c_;
-            const double rot = std::fabs(c_to - c_);
-            if (len > 0 && rot > 0) fail(note, "a feed move of C together with X/Y/Z (not planned, not simulated)");
             if (note.cut && !tool_.cutter) fail(note, "a cut without a cutter in the spindle");
             if (note.cut && spindle_rpm_ == 0) fail(note, "a cut with the spindle stopped");
             checkTravel(g, note, "feed move");
-            if (rot > 0) {
-              if (!m_.c.present) fail(note, "C move on a machine without a C axis (" + m_.file + ")");
-              const double turning = m_.c.max_turning_speed_rpm > 0 ? m_.c.max_turning_speed_rpm : m_.c.max_speed_rpm;
-              if (!(f.feed > 0)) fail(note, "a C feed move without a feed rate");
-              if (f.feed / 360.0 > turning + 1e-9)
-                fail(note, "C feed F" + formatNumber(f.feed, 3) + " deg/min = " + formatNumber(f.feed / 360.0, 3) +
-                               " rpm exceeds C's max_turning_speed " + formatNumber(turning, 3) + " rpm of " + m_.file);
-              motion("C feed move", to, c_to, note);
-              const double dt = rot / f.feed * 60.0;
-              times_.rotary_feed_s += dt;
-              t_ += dt;
-              c_ = c_to;
-            } else {
-              checkLinearFeed(f.feed, note, note.cut ? "cut" : "feed move");
-              motion(note.cut ? "cut" : "feed move", to, c_, note);
-              const double dt = len / f.feed * 60.0;
-              times_.feed_s += dt;
-              t_ += dt;
-            }
+            checkLinearFeed(f.feed, note, note.cut ? "cut" : "feed move");
+            motion(MotionKind::Feed, note.cut ? "cut" : "feed move", to, c_, note);
+            const double dt = linearFeedSeconds((g - gauge_).norm(), f.feed);
+            times_.feed_s += dt;
+            t_ += dt;
             gauge_ = g;
+          },
+          [&](const gcode::TurnC& r) {
+            if (note.cut && !tool_.cutter) fail(note, "a cut without a cutter in the spindle");
+            if (note.cut && spindle_rpm_ == 0) fail(note, "a cut with the spindle stopped");
+            const double c_to = c_ + r.delta_deg;
+            checkCTravel(c_to, note, "C feed move");
+            const double F = r.feed_deg_per_min, turning = m_.c.max_turning_speed_rpm;
+            if (!(F > 0)) fail(note, "a C feed move without a feed rate");
+            if (F / 360.0 > turning + 1e-9)
+              fail(note, "C feed F" + formatNumber(F, 3) + " deg/min = " + formatNumber(F / 360.0, 3) +
+                             " rpm exceeds C's max_turning_speed " + formatNumber(turning, 3) + " rpm of " + m_.file);
+            motion(MotionKind::CFeed, "C feed move", tip(), c_to, note);
+            const double dt = rotaryFeedSeconds(r.delta_deg, F);
+            times_.rotary_feed_s += dt;
+            t_ += dt;
+            c_ = c_to;
           },
           [&](const gcode::ProtectedMove& pm) {
             if (!tool_.probe) fail(note, "a protected probe move without the probe in the spindle");
@@ -234,8 +256,8 @@ void ProgramWalker::step(const gcode::Op& op, const OpNote& note) {
             const Vector3d to(pm.x, pm.y, pm.z), g = to + Vector3d(0, 0, L);
             checkTravel(g, note, "protected move");
             checkLinearFeed(pm.feed_mm_per_min, note, "protected move");
-            motion("protected move", to, c_, note);
-            const double dt = (g - gauge_).norm() / pm.feed_mm_per_min * 60.0;
+            motion(MotionKind::Protected, "protected move", to, c_, note);
+            const double dt = linearFeedSeconds((g - gauge_).norm(), pm.feed_mm_per_min);
             times_.protected_s += dt;
             t_ += dt;
             gauge_ = g;
@@ -247,10 +269,10 @@ void ProgramWalker::step(const gcode::Op& op, const OpNote& note) {
             const Vector3d to(pm.x, pm.y, pm.z), g = to + Vector3d(0, 0, L);
             checkTravel(g, note, "probing move end (overtravel)");
             checkLinearFeed(pm.feed_mm_per_min, note, "probing move");
-            motion("probe move", to, c_, note);
+            motion(MotionKind::Measuring, "probe move", to, c_, note);
             // Timed to the nominal contact, where the controller latches and stops.
             const Vector3d gc = note.contact_mm + Vector3d(0, 0, L);
-            const double dt = (gc - gauge_).norm() / pm.feed_mm_per_min * 60.0;
+            const double dt = linearFeedSeconds((gc - gauge_).norm(), pm.feed_mm_per_min);
             times_.probing_s += dt;
             t_ += dt;
             gauge_ = gc;

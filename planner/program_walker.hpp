@@ -2,22 +2,26 @@
 // and checks every target before any text is written. Used by the planners of machined
 // test pieces (planner/thermal_test_piece.hpp).
 //
-// Clock (exactly docs/simulator.md §2 "Clock", no acceleration): rapids move every axis at
-// the rapid feed (B and C at their maximum positioning speed) and take the slowest axis's
-// time; feeds take XYZ path length / F, a move of a rotary axis alone degrees / F; protected
-// moves run to their end; measuring moves are timed to the nominal contact the planner
-// names; dwells; tool changes at tool_change.time. Several programs run back to back in one
-// session: position, C, tool and clock carry over. The machine starts with the gauge line at
-// the top of the Z travel above the C axis (clamped into the X/Y travel), C = B = 0, empty
-// spindle.
+// Clock (exactly docs/simulator.md §2 "Clock", no acceleration; the functions below are the
+// one copy of it in the planner, the walker's and its tests'): rapids move every axis at the
+// rapid feed (B and C at their maximum positioning speed) and take the slowest axis's time;
+// feeds take XYZ path length / F, a move of C alone (TurnC) degrees / F; protected moves run
+// to their end; measuring moves are timed to the nominal contact the planner names; dwells;
+// tool changes at tool_change.time. Several programs run back to back in one session:
+// position, C, tool and clock carry over. The machine starts with the gauge line at the top of
+// the Z travel above the C axis (clamped into the X/Y travel), C = B = 0, empty spindle. C is
+// a linear axis here, as in the simulator: after TurnC +360 it reads 360, and an absolute
+// index from there turns the long way (a control with C rollover may go another way round:
+// only the time differs, docs/thermal-test-piece.md §5).
 //
 // Checks (SafetyError "<program>: <where>: <what> ..." naming the axis and value): every
-// target of the gauge line (tip + tool length) within the X/Y/Z travel, B and C within
-// theirs; linear feeds within the slowest axis's max_feed (as the simulator checks them);
-// a move of C alone within C's max_turning_speed; a cut only with a cutter and the spindle
-// turning; probing only with the probe and the spindle stopped; a tool change only with the
-// spindle stopped; no feed move of C together with X/Y/Z (not modelled anywhere). Collisions
-// are the caller's: every motion is handed to its check first (Motion).
+// number finite; every target of the gauge line (tip + tool length) within the X/Y/Z travel,
+// B and C within theirs (a non-continuous C also for TurnC); linear feeds within the slowest
+// axis's max_feed (as the simulator checks them); a move of C alone within C's
+// max_turning_speed; a cut only with a cutter and the spindle turning; probing only with the
+// probe and the spindle stopped; a tool change only with the spindle stopped and the gauge
+// line at the tool-change height (G53 Z tool_change.z). Collisions are the caller's: every
+// motion is handed to its check first (Motion).
 #pragma once
 #include <Eigen/Dense>
 #include <functional>
@@ -44,10 +48,9 @@ struct NotedProgram {
   std::string file, role;
   gcode::Program program;
   std::vector<OpNote> notes;
-  void add(gcode::Op op, OpNote note) {
-    program.ops.push_back(std::move(op));
-    notes.push_back(std::move(note));
-  }
+  // GeometryError "<file>: <where>: ..." for an op holding a number that is not finite (a
+  // layout the planner did not refuse earlier: never written as "nan").
+  void add(gcode::Op op, OpNote note);
 };
 
 // A tool the walker knows: from the part's tool list, the machine's probe, the empty spindle.
@@ -57,12 +60,23 @@ struct WalkerTool {
   bool probe = false, cutter = false;
 };
 
+enum class MotionKind {
+  Rapid,       // G0 of X/Y/Z (program coordinates)
+  MachineZ,    // G53 G0 Z: the retract to the tool-change height
+  CIndex,      // G0 C
+  Feed,        // G1 X/Y/Z (a cut when the note says so)
+  CFeed,       // TurnC: C alone at a feed
+  Protected,   // protected probe move
+  Measuring,   // the measuring move (meant to touch the part)
+};
+
 // A motion about to be made, for the caller's collision check (program = machine tip
 // coordinates; C in degrees).
 struct Motion {
   const std::string* program = nullptr;
   const OpNote* note = nullptr;
-  const char* what = "";  // "rapid", "feed", "protected move", "probe move", "C index" ...
+  MotionKind kind = MotionKind::Rapid;
+  const char* what = "";  // for messages: "rapid move", "cut", "C feed move", "probe move" ...
   Eigen::Vector3d from_tip = Eigen::Vector3d::Zero(), to_tip = Eigen::Vector3d::Zero();
   double from_c = 0, to_c = 0;
   WalkerTool tool;
@@ -92,8 +106,9 @@ class ProgramWalker {
  private:
   void step(const gcode::Op& op, const OpNote& note);
   void checkTravel(const Eigen::Vector3d& gauge, const OpNote& note, const char* what) const;
+  void checkCTravel(double c_deg, const OpNote& note, const char* what) const;
   void checkLinearFeed(double F, const OpNote& note, const char* what) const;
-  void motion(const char* what, const Eigen::Vector3d& to_tip, double to_c, const OpNote& note) const;
+  void motion(MotionKind kind, const char* what, const Eigen::Vector3d& to_tip, double to_c, const OpNote& note) const;
   [[noreturn]] void fail(const OpNote& note, const std::string& message) const;
   const WalkerTool& toolFor(int number, const OpNote& note) const;
 
@@ -106,6 +121,16 @@ class ProgramWalker {
   WalkerTool tool_;  // number 0 = empty spindle until the first change
   WalkTimes times_;
 };
+
+// The simulator's clock (docs/simulator.md §2), in seconds.
+// A rapid: every axis at once, linear ones at the rapid feed, B and C at their max_speed.
+double rapidSeconds(const parts::Machine& m, const Eigen::Vector3d& gauge_delta_mm, double b_delta_deg = 0,
+                    double c_delta_deg = 0);
+// A rotary axis indexing by `delta_deg` at its positioning speed (max_speed).
+double rotaryIndexSeconds(double delta_deg, const parts::RotaryAxis& axis);
+// A feed move: XYZ path length / F; a move of C alone: degrees / F (F in deg/min).
+double linearFeedSeconds(double path_mm, double feed_mm_per_min);
+double rotaryFeedSeconds(double delta_deg, double feed_deg_per_min);
 
 // The value a writer prints (coordinates 4 decimals, C / feeds / dwells 3): planners build
 // their ops from these so that what they time is what the controller reads.

@@ -8,6 +8,7 @@
 #include "core/csv.hpp"
 #include "core/error.hpp"
 #include "core/units.hpp"
+#include "planner/angles.hpp"
 
 namespace probeloop::planner {
 
@@ -17,20 +18,16 @@ using parts::SphereArtifact;
 
 namespace {
 
-double wrapDeg(double a) {
-  a = std::fmod(a, 360.0);
-  if (a < 0) a += 360.0;
-  if (a >= 360.0 - 1e-9) a = 0.0;
-  return a;
-}
-
 bool sameAngle(double a, double b) {
-  const double d = std::fabs(wrapDeg(a) - wrapDeg(b));
+  const double d = std::fabs(wrapDeg360(a) - wrapDeg360(b));
   return d < 1e-9 || std::fabs(d - 360.0) < 1e-9;
 }
 
 // Walks the ops like a machine would, to time them and to check every target against the
-// travel of the gauge line.
+// travel of the gauge line. Not planner/program_walker.hpp on purpose: this walker starts at
+// the tool-change height above an unknown XY and times each cycle alone, the shared walker
+// starts where the simulator does and runs the whole session; porting the sphere cycle to it
+// would change its planned times and so the bytes of its plan.json and program header.
 class Walker {
  public:
   Walker(const Machine& m, CycleTime& t) : m_(m), t_(t) {
@@ -122,7 +119,7 @@ SpherePlan planSphereCycle(const SphereArtifact& a, const Machine& m, const Plan
   const double r_tip = m.probe.tip_diameter_mm / 2;
   const double R = a.sphereRadius();
   const double Rt = R + r_tip;  // stylus-tip centre distance from the sphere centre at contact
-  const double sense = m.c.positive_is_clockwise ? -1.0 : 1.0;
+  const double sense = parts::tableTurnSign(m.c.positive_is_clockwise);
   if (!m.c.present)
     throw InputError(m.file, 0, "axes.C: the sphere-artifact cycle needs a rotary table (C axis); this machine has none");
 
@@ -143,7 +140,7 @@ SpherePlan planSphereCycle(const SphereArtifact& a, const Machine& m, const Plan
     s.position = static_cast<int>(k + 1);
     s.id = "S" + std::to_string(s.position);
     s.c_deg = a.c_positions_deg[k];
-    s.angle_deg = wrapDeg(a.angle_at_c0_deg + sense * s.c_deg);
+    s.angle_deg = wrapDeg360(a.angle_at_c0_deg + sense * s.c_deg);
     const double th = degToRad(s.angle_deg);
     s.nominal_centre_mm = Vector3d(m.c_axis_centre_mm.x() + a.radius_from_axis_mm * std::cos(th),
                                    m.c_axis_centre_mm.y() + a.radius_from_axis_mm * std::sin(th),

@@ -66,9 +66,10 @@ TestPiecePlan sphere(const parts::SphereArtifact& a, const parts::Machine& m, pa
   return out;
 }
 
-TestPiecePlan thermal(const parts::ThermalTestPiece& t, const parts::Machine& m, parts::Dialect dialect,
-                      const std::string& out_dir) {
-  auto plan = planThermalTestPiece(t, m, dialect);
+TestPiecePlan thermal(const parts::TestPiece& piece, const parts::ThermalTestPiece& t, const parts::Machine& m,
+                      parts::Dialect dialect, const std::string& out_dir) {
+  // The features and evaluation rules of the loaded test piece, as the manifest carries them.
+  auto plan = planThermalTestPiece(t, piece.features, piece.evaluation, m, dialect);
   TestPiecePlan out;
   for (std::size_t i = 0; i < plan.programs.size(); ++i) {
     PlannedProgram p;
@@ -155,7 +156,7 @@ TestPiecePlan thermal(const parts::ThermalTestPiece& t, const parts::Machine& m,
 TestPiecePlan planTestPiece(const parts::TestPiece& piece, const parts::Machine& machine, parts::Dialect dialect,
                             const std::string& out_dir) {
   if (const auto* a = piece.sphereArtifact()) return sphere(*a, machine, dialect, out_dir);
-  if (const auto* t = piece.thermalTestPiece()) return thermal(*t, machine, dialect, out_dir);
+  if (const auto* t = piece.thermalTestPiece()) return thermal(piece, *t, machine, dialect, out_dir);
   if (piece.kind == "workpiece")
     throw InputError(piece.file, 0,
                      "a plain workpiece has no planner: write its program yourself and run it with probeloop simulate");

@@ -3,7 +3,8 @@
 // files beside it and the summary `probeloop plan` prints.
 //
 // Contract: sphere_artifact -> the sphere cycle (planner/sphere_cycle.hpp), byte for byte
-// what planSphereCycle + programText give; thermal_test_piece -> planner/thermal_test_piece.hpp;
+// what planSphereCycle + programText give; thermal_test_piece -> planner/thermal_test_piece.hpp
+// with the piece's own `features` and `evaluation` (into the manifest as they are);
 // workpiece -> InputError (a plain workpiece has no planner). Nothing is written here: the
 // caller writes programs[].text to programs[].file, files[] and plan.json
 // (parts::manifestToJson(manifest)) into one folder. `out_dir` only names that folder in the

@@ -81,3 +81,18 @@ TEST(PlanTestPiece, TheThermalTestPieceGivesThreeProgramsTheCmmPlanAndASummary) 
   EXPECT_NE(lc.programs[2].text.find("(LOGOPEN,ttp_probe.log)\n#<_pl_cycle> = 1\n"), std::string::npos);
   EXPECT_EQ(lc.manifest.dialect, "linuxcnc");
 }
+
+// The planner uses the loaded model's features and evaluation rules, not a second computation.
+TEST(PlanTestPiece, TheThermalTestPiecesFeaturesAndEvaluationComeFromTheLoadedModel) {
+  auto piece = parts::loadTestPiece(src + "/parts/thermal_test_piece.yaml");
+  piece.features.front().half_u_mm = 42.5;  // TOP, as the model has it
+  piece.evaluation = {piece.evaluation.front()};
+  piece.evaluation.front().formula = "as loaded";
+  const auto plan = planTestPiece(piece, machine("nmv5000"), parts::Dialect::FanucMacroB);
+  ASSERT_EQ(plan.manifest.features.size(), piece.features.size());
+  EXPECT_EQ(plan.manifest.features.front().nominal.id, "TOP");
+  EXPECT_EQ(plan.manifest.features.front().nominal.half_u_mm, 42.5);
+  ASSERT_EQ(plan.manifest.evaluation.size(), 1u);
+  EXPECT_EQ(plan.manifest.evaluation.front().formula, "as loaded");
+  for (std::size_t i = 0; i < piece.features.size(); ++i) EXPECT_EQ(plan.manifest.features[i].nominal.id, piece.features[i].id);
+}

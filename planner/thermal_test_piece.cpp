@@ -1,8 +1,8 @@
 #include "planner/thermal_test_piece.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <cstring>
 #include <optional>
 #include <sstream>
 
@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "core/units.hpp"
 #include "parts/test_piece.hpp"
+#include "planner/angles.hpp"
 
 namespace probeloop::planner {
 
@@ -27,18 +28,9 @@ constexpr double kOutside = 2.0;
 constexpr double kMaxRingStepDeg = 30.0;
 // The most whole turns one C feed move of the load may command (8-digit C words).
 constexpr int kMaxTurnsPerMove = 277;
-
-double wrap360(double a) {
-  a = std::fmod(a, 360.0);
-  if (a < 0) a += 360.0;
-  if (a >= 360.0 - 5e-4) a = 0.0;  // 359.9999 prints as 360.000
-  return a;
-}
-
-Vector2d rot(const Vector2d& v, double deg) {
-  const double a = degToRad(deg), c = std::cos(a), s = std::sin(a);
-  return {c * v.x() - s * v.y(), s * v.x() + c * v.y()};
-}
+// Z-path inspection points keep this far from the strips the test's facet cuts sweep over the
+// notch floor (as the loader keeps facet points from a facet's edge; docs §5).
+constexpr double kStripMargin = 0.5;
 
 // --- 2D geometry of the finished part (collision checks) -------------------------------
 
@@ -148,14 +140,97 @@ std::vector<double> levels(double depth, double step) {
   return v;
 }
 
+// The collision rules of docs/thermal-test-piece.md §5 for every motion the walker is about to
+// make (SafetyError "<program>: <where>: ..."). `finished`: after pre-machining, when the
+// notches and the facets (at their allowance) have opened the part.
+struct Collisions {
+  const Envelope& env;
+  Vector3d O;  // part origin, machine tip coordinates at C = 0
+  bool cw;     // +C turns the table clockwise (C')
+
+  void check(const Motion& mo, bool finished) const {
+    const std::string tool = mo.tool.probe ? "probe" : "tool T" + std::to_string(mo.tool.number);
+    auto fail = [&](const std::string& m) { throw SafetyError(*mo.program + ": " + mo.note->where + ": " + m); };
+    const Vector3d qa = mo.from_tip - O, qb = mo.to_tip - O;
+    if (!qa.allFinite() || !qb.allFinite() || !std::isfinite(mo.from_c) || !std::isfinite(mo.to_c))
+      fail(std::string(mo.what) + " to a position that is not a finite number");
+    const double rho = mo.tool.radius_mm;
+    const double below = mo.tool.probe ? rho : 0.0;  // lowest point of the tool under its tip coordinate
+    const double top = env.top(finished);
+    // Below the top a G0 moves one axis at a time: a G0 of several axes may dog-leg (Fanuc
+    // non-linear positioning), so such moves are G1 (docs §5).
+    if (mo.kind == MotionKind::Rapid && std::min(qa.z(), qb.z()) - below < top - 1e-9) {
+      int axes = 0;
+      // (1 um: a retract starts at the unrounded contact, its target is rounded to 0.1 um.)
+      for (int i = 0; i < 3; ++i) axes += std::fabs(qa(i) - qb(i)) > 1e-3;
+      if (axes > 1)
+        fail("G0 from " + xyz(mo.from_tip) + " to " + xyz(mo.to_tip) + " moves " + std::to_string(axes) +
+             " axes with the " + tool + " below the top of the part (a G0 may dog-leg: only G1 there)");
+    }
+    // Cuts and measuring moves are meant to touch the part; a retract leaves a contact straight
+    // back along the approach line, which the protected move came down clear of.
+    if (mo.note->cut || mo.note->retract || mo.kind == MotionKind::Measuring) return;
+    if (mo.kind == MotionKind::CIndex || mo.kind == MotionKind::CFeed) {
+      if (mo.from_c == mo.to_c) return;
+      const double zb = qa.z() - below;
+      if (zb >= top - 1e-9) return;
+      const double r = qa.head<2>().norm();
+      double need = finished && zb >= env.floor - 1e-9 ? env.segments_r + rho : env.R + rho;
+      if (zb < -env.H - 1e-9) need = std::max(need, env.fixture_r + rho);
+      if (r < need - 1e-9)
+        fail(std::string(mo.what) + " turns C from " + formatNumber(mo.from_c, 3) + " to " + formatNumber(mo.to_c, 3) +
+             " deg with the " + tool + " at " + xyz(mo.from_tip) + ", " + formatNumber(r, 3) +
+             " mm from the C axis: inside the circle the part sweeps (needs " + formatNumber(need, 3) + " mm, or the " + tool +
+             " above the part)");
+      return;
+    }
+    // Straight up: the part only narrows upward (bands step in, notches and facets open
+    // upward), so a tool rising from where it stands meets nothing.
+    if ((qa.head<2>() - qb.head<2>()).norm() < 1e-9 && qb.z() >= qa.z()) return;
+    const double zb = std::min(qa.z(), qb.z()) - below;
+    if (zb >= top - 1e-9) return;
+    const Vector2d pa = parts::unturnedByTable(qa.head<2>(), mo.from_c, cw),
+                   pb = parts::unturnedByTable(qb.head<2>(), mo.from_c, cw);  // part frame
+    const double d_axis = segmentOrigin(pa, pb);
+    double need = env.R + rho;
+    if (zb < -env.H - 1e-9) need = std::max(need, env.fixture_r + rho);
+    if (d_axis >= need - 1e-9) return;
+    double d_part = 0;
+    if (finished && zb >= env.floor - 1e-9) {
+      d_part = INFINITY;
+      for (const auto& s : env.segments) d_part = std::min(d_part, segmentPolygon(pa, pb, s));
+      if (d_part >= rho - 1e-9) return;
+    }
+    fail(std::string(mo.what) + " from " + xyz(mo.from_tip) + " to " + xyz(mo.to_tip) + " at C " + formatNumber(mo.from_c, 3) +
+         " would take the " + tool + " through the part: it comes " + formatNumber(d_axis, 3) +
+         " mm near the C axis below the top (needs " + formatNumber(need, 3) + " mm outside the blank" +
+         (finished ? ", or " + formatNumber(rho, 3) + " mm clear of the segments above the notch floor" : "") + ")");
+  }
+};
+
+std::vector<WalkerTool> walkerTools(const ThermalTestPiece& t) {
+  std::vector<WalkerTool> tools;
+  for (const auto& c : t.tools) {
+    WalkerTool w;
+    w.number = c.number;
+    w.length_mm = c.length_mm;
+    w.radius_mm = c.diameter_mm / 2;
+    w.cutter = true;
+    tools.push_back(w);
+  }
+  return tools;
+}
+
 class Builder {
  public:
-  Builder(const ThermalTestPiece& t, const parts::Machine& m, parts::Dialect d)
-      : t_(t), m_(m), dialect_(d), env_(t), files_(ttpFiles(d)) {
+  Builder(const ThermalTestPiece& t, const std::vector<parts::NominalFeature>& features,
+          const std::vector<parts::EvaluationRule>& evaluation, const parts::Machine& m, parts::Dialect d)
+      : t_(t), m_(m), dialect_(d), env_(t), files_(ttpFiles(d)), features_(features), evaluation_(evaluation) {
     if (!m.c.present)
       throw InputError(m.file, 0, "axes.C: the thermal test piece needs a rotary table (C axis); " + m.name + " has none");
     O_ = parts::partOriginOnMachine(t, m.c_axis_centre_mm, m.table_surface_z_mm);
-    sense_ = m.c.positive_is_clockwise ? -1.0 : 1.0;
+    cw_ = m.c.positive_is_clockwise;
+    checkLayout();
     travel_feed_ = std::min({m.rapid_feed_mm_per_min, m.x.max_feed_mm_per_min, m.y.max_feed_mm_per_min, m.z.max_feed_mm_per_min});
     clearance_ = t.probing.clearance_mm;
     for (int n : {t.band_tool, t.face_tool, t.mark_tool, t.y_notch_tool, t.x_notch_tool, t.facet_pre_tool, t.test_tool}) {
@@ -169,7 +244,6 @@ class Builder {
   }
 
   ThermalTestPiecePlan build() {
-    features_ = parts::nominalFeatures(t_);
     cycles_ = parts::cuttingCycles(t_);
     for (std::size_t i = 0; i < features_.size(); ++i) {
       parts::ManifestFeature f;
@@ -185,12 +259,102 @@ class Builder {
     plan_.programs = std::move(programs_);
     plan_.manifest = std::move(man_);
     plan_.cmm_points_csv = cmmCsv();
-    plan_.top_z_mm = O_.z();
     plan_.test_cutting_z_mm = round4(O_.z() + t_.cuttingZ());
     return std::move(plan_);
   }
 
  private:
+  // --- the layout ---------------------------------------------------------------------------
+  const parts::NominalFeature& feature(const std::string& id) const {
+    for (const auto& f : features_)
+      if (f.id == id) return f;
+    throw std::logic_error("thermal test piece: the features handed to the planner lack " + id);
+  }
+
+  // The description's layout must leave every surface the programs cut and probe: an
+  // InputError naming the key, never a NaN in a program (docs/thermal-test-piece.md §5).
+  void checkLayout() const {
+    const double a = t_.facet_apothem_mm, wx = t_.x_notch_width_mm / 2, wy = t_.y_notch_width_mm / 2;
+    const double rt = m_.probe.tip_diameter_mm / 2;
+    const FacetSide sides[4] = {FacetSide::X1, FacetSide::Y1, FacetSide::X2, FacetSide::Y2};
+    // Every facet's centre on a segment: a facet whose centre lies in a notch is cut away.
+    for (auto s : sides)
+      for (int k = 1; k <= t_.facets_per_segment; ++k) {
+        const double th = degToRad(parts::facetNormalAngle(t_, s, k));
+        const Vector2d c = a * Vector2d(std::cos(th), std::sin(th));
+        const bool in_x = !(std::fabs(c.y()) > wx), in_y = !(std::fabs(c.x()) > wy);
+        if (in_x || in_y)
+          throw InputError(t_.file, 0,
+                           std::string(in_x ? "pre_machining.x_notch.width: " : "pre_machining.y_notch.width: ") +
+                               formatNumber(in_x ? t_.x_notch_width_mm : t_.y_notch_width_mm) + " mm cuts facet " +
+                               parts::facetId(s, k) + " away: its centre (x " + formatNumber(c.x(), 2) + ", y " +
+                               formatNumber(c.y(), 2) + " mm) lies in the notch (|" + (in_x ? "y" : "x") + "| < " +
+                               formatNumber(in_x ? wx : wy) +
+                               " mm); narrow the notch or turn the facets (pre_machining.facets.first_normal_angle, pitch)");
+      }
+    topPoints();  // throws when the notches leave no room for them
+    // The flank points at 1/4 and 3/4 of each flank beside the Y notch keep a tip radius from its ends.
+    const double flank = feature("FLANK_P").half_u_mm - wy;
+    if (!(flank >= 4 * rt))
+      throw InputError(t_.file, 0,
+                       "pre_machining.x_notch.width: " + formatNumber(t_.x_notch_width_mm) + " mm leaves flanks " +
+                           formatNumber(flank, 2) + " mm long beside the Y notch; the inspection's flank points need " +
+                           formatNumber(4 * rt) + " mm (4 tip radii)");
+    // The test's facet cuts run with the tool's bottom at the cutting height, 0.1 mm below the
+    // notch floor: where a facet's chord passes over the notch the tool re-cuts the floor in a
+    // strip (a facet normal's projection between a and a + 2r). A Z-path point there (or
+    // within kStripMargin of it) would measure another cycle's cut.
+    const double r = radius(t_.test_tool), ap = a + r, L = t_.facet_path_half_length_mm;
+    for (auto s : sides)
+      for (int k = 1; k <= t_.facets_per_segment; ++k) {
+        const double th = degToRad(parts::facetNormalAngle(t_, s, k));
+        const Vector2d n(std::cos(th), std::sin(th)), u(-n.y(), n.x());
+        const Vector2d A = ap * n + L * u, B = ap * n - L * u;
+        for (int j = 1; j <= t_.z_paths; ++j)
+          for (double x : t_.z_path_points_along_mm)
+            for (double d : t_.z_path_points_across_mm) {
+              const Vector2d p(x, parts::zPathY(t_, j) + d);
+              const double gap = pointSegment(p, A, B) - r;
+              if (gap < kStripMargin)
+                throw InputError(t_.file, 0,
+                                 "inspection.z_path_points.along: the point x " + formatNumber(p.x()) + " y " +
+                                     formatNumber(p.y()) + " mm of Z path " + parts::zPathId(j) +
+                                     (gap < 0 ? " lies in" : " lies " + formatNumber(gap, 2) + " mm from") +
+                                     " the strip of notch floor the test's cuts of facet " + parts::facetId(s, k) +
+                                     " re-cut at the cutting height (in another cycle than the path); keep it " +
+                                     formatNumber(kStripMargin) + " mm away (docs/thermal-test-piece.md §5)");
+            }
+      }
+  }
+
+  // The TOP points of the +X+Y segment (mirrored into the others): two on the circle a - 2 r_tip
+  // at 30 % and 70 % of the segment's angle between the notches (2 r_tip clear of both), one
+  // 2 r_tip outside the notch corner on the middle angle. InputError when the notches leave no
+  // room for them.
+  std::array<Vector2d, 3> topPoints() const {
+    const double rt = m_.probe.tip_diameter_mm / 2, a = t_.facet_apothem_mm, r_o = a - 2 * rt;
+    const double wx = t_.x_notch_width_mm / 2, wy = t_.y_notch_width_mm / 2;
+    auto refuse = [&](const std::string& key, const std::string& why) {
+      throw InputError(t_.file, 0, key + ": " + why + ": no room on the top for the inspection's TOP points, which keep " +
+                                       formatNumber(2 * rt) + " mm (a tip diameter) from the notches and inside the facets' " +
+                                       formatNumber(r_o, 2) + " mm circle (apothem - a tip diameter)");
+    };
+    const double s_lo = (wx + 2 * rt) / r_o, c_hi = (wy + 2 * rt) / r_o;
+    if (!(r_o > 0 && s_lo < 1)) refuse("pre_machining.x_notch.width", formatNumber(t_.x_notch_width_mm) + " mm");
+    if (!(c_hi < 1)) refuse("pre_machining.y_notch.width", formatNumber(t_.y_notch_width_mm) + " mm");
+    const double lo = std::asin(s_lo), hi = std::acos(c_hi);
+    if (!(lo < hi))
+      refuse("pre_machining.x_notch.width", formatNumber(t_.x_notch_width_mm) + " mm with the y_notch " +
+                                                formatNumber(t_.y_notch_width_mm) + " mm");
+    const double mid = (lo + hi) / 2;
+    const double r_in = std::max(wx / std::sin(mid), wy / std::cos(mid)) + 2 * rt;
+    if (!(r_in < r_o))
+      refuse("pre_machining.x_notch.width", formatNumber(t_.x_notch_width_mm) + " mm with the y_notch " +
+                                                formatNumber(t_.y_notch_width_mm) + " mm");
+    auto at = [](double r, double ang) { return Vector2d(r * std::cos(ang), r * std::sin(ang)); };
+    return {at(r_o, lo + 0.3 * (hi - lo)), at(r_o, lo + 0.7 * (hi - lo)), at(r_in, mid)};
+  }
+
   // --- program building ----------------------------------------------------------------
   NotedProgram& P() { return programs_.back(); }
   void add(gcode::Op op, const std::string& where, bool cut = false, int cut_index = -1) {
@@ -223,11 +387,11 @@ class Builder {
     if (std::fabs(qx - pos_.x()) > 1e-12) x = mx(qx);
     if (std::fabs(qy - pos_.y()) > 1e-12) y = my(qy);
     if (!x && !y) return;
-    add(gcode::Feed{x, y, std::nullopt, std::nullopt, round3(F)}, w, cut, ci);
+    add(gcode::Feed{x, y, std::nullopt, round3(F)}, w, cut, ci);
     pos_ = {qx, qy};
   }
   void feedZ(double z, double F, const std::string& w, bool cut = false) {
-    add(gcode::Feed{std::nullopt, std::nullopt, mz(z), std::nullopt, round3(F)}, w, cut);
+    add(gcode::Feed{std::nullopt, std::nullopt, mz(z), round3(F)}, w, cut);
   }
   void indexC(double c, const std::string& w) {
     checkCResolution(c, w);
@@ -242,14 +406,26 @@ class Builder {
   void toolChange(int tool, const std::string& w) {
     if (!at_tool_change_z_) add(gcode::RapidMachineZ{m_.tool_change.z_mm}, w + ": retract to the tool-change height");
     add(gcode::ToolChange{tool, tool != m_.tool_change.empty_tool}, w);
+    current_tool_ = tool;
   }
   void spindleOn(double rpm, bool coolant, const std::string& w) {
     add(gcode::Spindle{std::round(rpm)}, w);
     if (coolant) add(gcode::Coolant{true}, w);
+    spindle_on_ = true;
   }
   void spindleOff(bool coolant, const std::string& w) {
     if (coolant) add(gcode::Coolant{false}, w);
     add(gcode::Spindle{0}, w);
+    spindle_on_ = false;
+  }
+  // Pre-machining's change to the next step's cutter: nothing when it is in the spindle already,
+  // else spindle (and coolant) off, retract, change, spindle on.
+  void cutterFor(int tool, const std::string& w) {
+    if (tool == current_tool_) return;
+    const bool wet = t_.pre_machining_coolant;
+    if (spindle_on_) spindleOff(wet, w + ": spindle off");
+    toolChange(tool, w + ": tool change");
+    spindleOn(t_.pre_spindle_rpm, wet, w + ": spindle on");
   }
   int addCut(const std::string& id, const std::string& feature, int cycle, int tool, double c, const Vector3d& from,
              const Vector3d& to) {
@@ -275,6 +451,8 @@ class Builder {
     p.program.work_offset = m_.work_offset;
     p.program.has_b_axis = m_.b.present;
     programs_.push_back(std::move(p));
+    current_tool_ = -1;
+    spindle_on_ = false;
     P().program.header = {
         "machine: " + m_.name,
         "part: " + t_.name + ", part frame origin at " + xyz(O_) + " [machine, C = 0]",
@@ -358,15 +536,14 @@ class Builder {
   void preMachining() {
     newProgram("pre_machining", files_.pre_machining, 2001,
                "probeloop thermal test piece: pre-machining [seed 004 L2002-L2018] - generated, do not edit");
-    toolHeader({t_.band_tool, t_.mark_tool, t_.y_notch_tool, t_.x_notch_tool});
+    toolHeader({t_.band_tool, t_.face_tool, t_.mark_tool, t_.y_notch_tool, t_.x_notch_tool, t_.facet_pre_tool});
     const bool wet = t_.pre_machining_coolant;
     const double zc = env_.blank_top + clearance_;
 
     // Step 1: the bands by turning C only, the tool standing on the machine's +X side of C at
     // Y0 (L2006: "at X0 or Y0"); bottom band first, so that each band leaves the one below.
     add(gcode::Comment{"step 1: bands by turning C only, bottom first [L2006]"}, "bands");
-    toolChange(t_.band_tool, "bands: tool change");
-    spindleOn(t_.pre_spindle_rpm, wet, "bands: spindle on");
+    cutterFor(t_.band_tool, "bands");
     const double rb = radius(t_.band_tool), x_out = env_.R + rb + kOutside;
     rapidXY(x_out, 0, "bands: beside the blank on +X");
     auto bands = t_.bands;
@@ -381,17 +558,16 @@ class Builder {
       const bool datum = std::fabs(b.diameter_mm - t_.datum_band_diameter_mm) < 1e-9;
       int ci = -1;
       if (datum) ci = addCut("CYL", "CYL", -1, t_.band_tool, 0, mach(x_cut, 0, b.z_from_mm), mach(x_cut, 0, b.z_from_mm));
-      add(gcode::Feed{std::nullopt, std::nullopt, std::nullopt, 360.0, F}, w + ": one turn of C", true, ci);
+      // Incremental (G91): an absolute C360 from C0 is a null move on a rollover axis.
+      add(gcode::TurnC{360.0, F}, w + ": one turn of C", true, ci);
       feedXY(x_out, 0, t_.band_feed_mm_per_min, w + ": feed radially out", true);
+      // C reads 360 on a linear axis (unwound here, the tool outside), 0 on a rollover axis.
       add(gcode::RotateC{0}, w + ": C back to 0 with the tool outside the blank");
     }
 
     // Face the top from +1 to 0: passes along X, stepover from the description.
     add(gcode::Comment{"step 1: face the top, z +" + formatNumber(t_.face_depth_mm) + " -> 0 [L2010]"}, "face");
-    if (t_.face_tool != t_.band_tool) {
-      toolChange(t_.face_tool, "face: tool change");
-      spindleOn(t_.pre_spindle_rpm, wet, "face: spindle on");
-    }
+    cutterFor(t_.face_tool, "face");
     rapidZ(zc, "face: clearance plane");
     {
       const double r = radius(t_.face_tool), out = env_.R + r + kOutside;
@@ -416,9 +592,7 @@ class Builder {
 
     // Step 2: the mark (engraved line).
     add(gcode::Comment{"step 2: engrave the mark [L2012]"}, "mark");
-    spindleOff(wet, "mark: spindle off");
-    toolChange(t_.mark_tool, "mark: tool change");
-    spindleOn(t_.pre_spindle_rpm, wet, "mark: spindle on");
+    cutterFor(t_.mark_tool, "mark");
     // A 0.5 mm tip: plunge and engrave at a quarter of the pre-machining feed (our choice).
     const double F_mark = t_.pre_feed_mm_per_min / 4;
     rapidXY(t_.mark_from_mm.x(), t_.mark_from_mm.y(), "mark: above its start");
@@ -430,9 +604,7 @@ class Builder {
 
     // Step 3: the Y notch: lanes in x inside |x| <= w/2, levels, passes along Y.
     add(gcode::Comment{"step 3: notch along Y [L2012]"}, "Y notch");
-    spindleOff(wet, "Y notch: spindle off");
-    toolChange(t_.y_notch_tool, "Y notch: tool change");
-    spindleOn(t_.pre_spindle_rpm, wet, "Y notch: spindle on");
+    cutterFor(t_.y_notch_tool, "Y notch");
     {
       const double r = radius(t_.y_notch_tool);
       passes(true, lanes(t_.y_notch_width_mm / 2 - r, std::min(t_.face_stepover_mm, 0.75 * 2 * r)),
@@ -443,9 +615,7 @@ class Builder {
     // Step 4: the X notch: rough leaving the allowance on the flanks and the floor, finish the
     // floor, then each flank in one climb-milling pass over the whole depth.
     add(gcode::Comment{"step 4: notch along X, rough and finish [L2014]"}, "X notch");
-    spindleOff(wet, "X notch: spindle off");
-    toolChange(t_.x_notch_tool, "X notch: tool change");
-    spindleOn(t_.pre_spindle_rpm, wet, "X notch: spindle on");
+    cutterFor(t_.x_notch_tool, "X notch");
     const double rx = radius(t_.x_notch_tool), a = t_.x_notch_allowance_mm, w2 = t_.x_notch_width_mm / 2;
     const double step_x = std::min(t_.face_stepover_mm, 0.75 * 2 * rx);
     const auto rough_lanes = lanes(w2 - a - rx, step_x);
@@ -468,11 +638,9 @@ class Builder {
     // Step 5: the facets at the allowance, each indexed to face machine +X, the tool on the
     // +X side moving -Y, its bottom at the notch floor so that the bands below stay whole.
     add(gcode::Comment{"step 5: facets at the allowance, each facing +X [L2016]"}, "facets");
-    if (t_.facet_pre_tool != t_.x_notch_tool) {
+    if (t_.facet_pre_tool != current_tool_) {
       rapidZ(zc, "facets: up to the clearance plane");
-      spindleOff(wet, "facets: spindle off");
-      toolChange(t_.facet_pre_tool, "facets: tool change");
-      spindleOn(t_.pre_spindle_rpm, wet, "facets: spindle on");
+      cutterFor(t_.facet_pre_tool, "facets");
       rapidXY(env_.R + radius(t_.facet_pre_tool) + kOutside, 0, "facets: beside the blank");
       rapidZ(t_.notchFloorZ(), "facets: down outside the blank");
     }
@@ -524,7 +692,7 @@ class Builder {
     toolChange(T, "test: tool change");
     rapidXY(W.x(), W.y(), "test: above the waiting position");
     rapidZ(0 + clearance_, "test: clearance plane");
-    add(gcode::Feed{std::nullopt, std::nullopt, mz(zc), std::nullopt, round3(travel_feed_)},
+    add(gcode::Feed{std::nullopt, std::nullopt, mz(zc), round3(travel_feed_)},
         "test: down to the cutting height beside the part (the one Z of the test)");
     for (const auto& cy : cycles_) {
       const int c = cy.cycle, j = cy.z_path, k = cy.facet;
@@ -589,9 +757,8 @@ class Builder {
     l.phase = cy.phase;
     l.requested_rpm = cy.c_axis_rpm_before;
     const std::string w = "load before test cycle " + std::to_string(cy.cycle);
-    const double turning = m_.c.max_turning_speed_rpm > 0 ? m_.c.max_turning_speed_rpm : m_.c.max_speed_rpm;
     if (l.requested_rpm > 0) {
-      l.rpm = std::min(l.requested_rpm, turning);
+      l.rpm = std::min(l.requested_rpm, m_.c.max_turning_speed_rpm);
       const double F = round3(l.rpm * 360.0);
       // Whole turns nearest to c_turn_move, at most 277 (99720 deg): a Fanuc takes 8 digits,
       // C up to 99999.999.
@@ -603,15 +770,18 @@ class Builder {
       l.pairs = static_cast<int>(std::floor(t_.wait_s / (2 * l.move_s) + 1e-9));
       l.dwell_s = round3(std::max(0.0, t_.wait_s - l.pairs * 2 * l.move_s));
       add(gcode::Comment{"wait " + formatNumber(t_.wait_s) + " s [" + cy.phase + "]: C at " + formatNumber(l.rpm) + " rpm, " +
-                         std::to_string(l.pairs) + " x [+" + std::to_string(l.turns_per_move) + " turns, back to 0]" +
+                         std::to_string(l.pairs) + " x [+" + std::to_string(l.turns_per_move) + " turns, -" +
+                         std::to_string(l.turns_per_move) + " turns]" +
                          (l.rpm < l.requested_rpm
                               ? " [" + formatNumber(l.requested_rpm) + " rpm asked; the machine's max_turning_speed]"
                               : "")},
           w);
       if (l.pairs > 0) {
+        // Incremental moves, +N and -N turns: C is back where it started after every pair on
+        // any control (absolute C72000 / C0 would not turn a rollover axis at all).
         add(gcode::LoopBegin{l.pairs, "_pl_load"}, w);
-        add(gcode::Feed{std::nullopt, std::nullopt, std::nullopt, l.turns_per_move * 360.0, F}, w + ": C turns forward");
-        add(gcode::Feed{std::nullopt, std::nullopt, std::nullopt, 0.0, F}, w + ": C turns back to 0");
+        add(gcode::TurnC{l.turns_per_move * 360.0, F}, w + ": C turns forward");
+        add(gcode::TurnC{-l.turns_per_move * 360.0, F}, w + ": C turns back");
         add(gcode::LoopEnd{}, w);
       }
       if (l.dwell_s > 0) add(gcode::Dwell{l.dwell_s}, w + ": the rest of the wait");
@@ -636,9 +806,8 @@ class Builder {
   };
   Planned planPoint(const std::string& feature, int position, int point, const ProbePoint& p) {
     const double rt = m_.probe.tip_diameter_mm / 2;
-    const double turn = sense_ * p.c;
     auto toMachine = [&](const Vector3d& v, bool direction) {
-      const Vector2d xy = rot(v.head<2>(), turn);
+      const Vector2d xy = parts::turnedByTable(v.head<2>(), p.c, cw_);
       return direction ? Vector3d(xy.x(), xy.y(), v.z()) : Vector3d(O_.x() + xy.x(), O_.y() + xy.y(), O_.z() + v.z());
     };
     const Vector3d n = toMachine(p.normal, true).normalized();
@@ -716,14 +885,7 @@ class Builder {
 
     // TOP: 3 points per segment, inside it, away from the notches and the mark (probing -Z).
     {
-      const double a = t_.facet_apothem_mm, r_o = a - 2 * rt;
-      const double lo = std::asin((t_.x_notch_width_mm / 2 + 2 * rt) / r_o);
-      const double hi = std::acos((t_.y_notch_width_mm / 2 + 2 * rt) / r_o);
-      const double mid = (lo + hi) / 2;
-      const double r_in = std::max((t_.x_notch_width_mm / 2) / std::sin(mid), (t_.y_notch_width_mm / 2) / std::cos(mid)) + 2 * rt;
-      const Vector2d q[3] = {r_o * Vector2d(std::cos(lo + 0.3 * (hi - lo)), std::sin(lo + 0.3 * (hi - lo))),
-                             r_o * Vector2d(std::cos(lo + 0.7 * (hi - lo)), std::sin(lo + 0.7 * (hi - lo))),
-                             r_in * Vector2d(std::cos(mid), std::sin(mid))};
+      const auto q = topPoints();
       const double sx[4] = {1, -1, -1, 1}, sy[4] = {1, 1, -1, -1};
       const int pos = positionOf("TOP");
       indexAtClearance(0, "inspection TOP");
@@ -820,67 +982,13 @@ class Builder {
   }
 
   // --- walking: clock and checks ----------------------------------------------------------
-  void check(const Motion& mo, bool finished) const {
-    // Cuts and measuring moves are meant to touch the part; a retract leaves a contact straight
-    // back along the approach line, which the protected move came down clear of.
-    if (mo.note->cut || mo.note->retract || std::strcmp(mo.what, "probe move") == 0) return;
-    const double rho = mo.tool.radius_mm;
-    const double below = mo.tool.probe ? rho : 0.0;  // lowest point of the tool under its tip coordinate
-    const Vector3d qa = mo.from_tip - O_, qb = mo.to_tip - O_;
-    const double top = env_.top(finished);
-    const std::string tool = mo.tool.probe ? "probe" : "tool T" + std::to_string(mo.tool.number);
-    auto fail = [&](const std::string& m) { throw SafetyError(*mo.program + ": " + mo.note->where + ": " + m); };
-    if (mo.from_c != mo.to_c) {
-      const double zb = qa.z() - below;
-      if (zb >= top - 1e-9) return;
-      const double r = qa.head<2>().norm();
-      double need = finished && zb >= env_.floor - 1e-9 ? env_.segments_r + rho : env_.R + rho;
-      if (zb < -env_.H - 1e-9) need = std::max(need, env_.fixture_r + rho);
-      if (r < need - 1e-9)
-        fail(std::string(mo.what) + " turns C from " + formatNumber(mo.from_c, 3) + " to " + formatNumber(mo.to_c, 3) +
-             " deg with the " + tool + " at " + xyz(mo.from_tip) + ", " + formatNumber(r, 3) +
-             " mm from the C axis: inside the circle the part sweeps (needs " + formatNumber(need, 3) + " mm, or the " + tool +
-             " above the part)");
-      return;
-    }
-    // Straight up: the part only narrows upward (bands step in, notches and facets open
-    // upward), so a tool rising from where it stands meets nothing.
-    if ((qa.head<2>() - qb.head<2>()).norm() < 1e-9 && qb.z() >= qa.z()) return;
-    const double zb = std::min(qa.z(), qb.z()) - below;
-    if (zb >= top - 1e-9) return;
-    const double turn = -sense_ * mo.from_c;  // machine -> part frame
-    const Vector2d pa = rot(qa.head<2>(), turn), pb = rot(qb.head<2>(), turn);
-    const double d_axis = segmentOrigin(pa, pb);
-    double need = env_.R + rho;
-    if (zb < -env_.H - 1e-9) need = std::max(need, env_.fixture_r + rho);
-    if (d_axis >= need - 1e-9) return;
-    double d_part = 0;
-    if (finished && zb >= env_.floor - 1e-9) {
-      d_part = INFINITY;
-      for (const auto& s : env_.segments) d_part = std::min(d_part, segmentPolygon(pa, pb, s));
-      if (d_part >= rho - 1e-9) return;
-    }
-    fail(std::string(mo.what) + " from " + xyz(mo.from_tip) + " to " + xyz(mo.to_tip) + " at C " + formatNumber(mo.from_c, 3) +
-         " would take the " + tool + " through the part: it comes " + formatNumber(d_axis, 3) +
-         " mm near the C axis below the top (needs " + formatNumber(need, 3) + " mm outside the blank" +
-         (finished ? ", or " + formatNumber(rho, 3) + " mm clear of the segments above the notch floor" : "") + ")");
-  }
-
   void walk() {
-    std::vector<WalkerTool> tools;
-    for (const auto& c : t_.tools) {
-      WalkerTool w;
-      w.number = c.number;
-      w.length_mm = c.length_mm;
-      w.radius_mm = c.diameter_mm / 2;
-      w.cutter = true;
-      tools.push_back(w);
-    }
-    ProgramWalker walker(m_, tools);
+    ProgramWalker walker(m_, walkerTools(t_));
+    const Collisions col{env_, O_, cw_};
     for (std::size_t i = 0; i < programs_.size(); ++i) {
       auto& p = programs_[i];
       const bool finished = p.role != "pre_machining";
-      walker.setCheck([this, finished](const Motion& mo) { check(mo, finished); });
+      walker.setCheck([&col, finished](const Motion& mo) { col.check(mo, finished); });
       const double t0 = walker.time();
       std::vector<double> before(p.program.ops.size(), NAN), after(p.program.ops.size(), NAN);
       walker.run(p, [&](std::size_t op, double a, double b) {
@@ -948,13 +1056,11 @@ class Builder {
     m.part_name = t_.name;
     m.part_origin_mm = O_;
     m.material_name = t_.material.name;
-    m.material_alpha_um_per_m_K = t_.material.alpha_per_K * 1e6;
-    m.evaluation = parts::thermalTestPieceEvaluation();
+    m.material_alpha_um_per_m_K = t_.material.alpha_um_per_m_K;
+    m.evaluation = evaluation_;
     auto& c = m.ttp;
     c.z_paths = t_.z_paths;
     c.facets_per_segment = t_.facets_per_segment;
-    c.facet_apothem_mm = t_.facet_apothem_mm;
-    c.test_tool_radius_mm = radius(t_.test_tool);
     c.eq_7_10_alpha_um_per_m_K = t_.eq_7_10_alpha_um_per_m_K;
     c.alpha_u_um_per_m_K = t_.alpha_u_um_per_m_K;
     c.eq_7_10_radius_mm = t_.eq_7_10_radius_mm;
@@ -1003,10 +1109,14 @@ class Builder {
   Envelope env_;
   TtpFiles files_;
   Vector3d O_;
-  double sense_ = -1, travel_feed_ = 0, clearance_ = 0;
+  bool cw_ = true;  // +C turns the table clockwise (C')
+  double travel_feed_ = 0, clearance_ = 0;
   Vector2d pos_ = Vector2d::Zero();  // current XY relative to the C axis (builder's view)
   bool at_tool_change_z_ = false;
-  std::vector<parts::NominalFeature> features_;
+  int current_tool_ = -1;     // in the spindle (builder's view; -1 = unknown at a program's start)
+  bool spindle_on_ = false;
+  const std::vector<parts::NominalFeature>& features_;
+  const std::vector<parts::EvaluationRule>& evaluation_;
   std::vector<parts::TtpCuttingCycle> cycles_;
   std::vector<NotedProgram> programs_;
   std::vector<std::size_t> cycle_first_op_, cycle_last_op_;
@@ -1028,13 +1138,32 @@ TtpFiles ttpFiles(parts::Dialect d) {
 }
 
 double cToFace(const parts::Machine& m, double part_angle_deg, double machine_angle_deg) {
-  // machine angle = part angle + s C, s = -1 for a table turning clockwise for +C.
-  const double s = m.c.positive_is_clockwise ? -1.0 : 1.0;
-  return wrap360((machine_angle_deg - part_angle_deg) / s);
+  // machine angle = part angle + s C (parts::tableTurnSign).
+  return wrapDeg360((machine_angle_deg - part_angle_deg) / parts::tableTurnSign(m.c.positive_is_clockwise));
+}
+
+ThermalTestPiecePlan planThermalTestPiece(const ThermalTestPiece& t, const std::vector<parts::NominalFeature>& features,
+                                          const std::vector<parts::EvaluationRule>& evaluation, const parts::Machine& m,
+                                          parts::Dialect dialect) {
+  return Builder(t, features, evaluation, m, dialect).build();
 }
 
 ThermalTestPiecePlan planThermalTestPiece(const ThermalTestPiece& t, const parts::Machine& m, parts::Dialect dialect) {
-  return Builder(t, m, dialect).build();
+  return planThermalTestPiece(t, parts::nominalFeatures(t), parts::thermalTestPieceEvaluation(), m, dialect);
+}
+
+void checkThermalTestPiecePrograms(const ThermalTestPiece& t, const parts::Machine& m,
+                                   const std::vector<NotedProgram>& programs) {
+  if (!m.c.present)
+    throw InputError(m.file, 0, "axes.C: the thermal test piece needs a rotary table (C axis); " + m.name + " has none");
+  const Envelope env(t);
+  const Collisions col{env, parts::partOriginOnMachine(t, m.c_axis_centre_mm, m.table_surface_z_mm), m.c.positive_is_clockwise};
+  ProgramWalker walker(m, walkerTools(t));
+  for (const auto& p : programs) {
+    const bool finished = p.role != "pre_machining";
+    walker.setCheck([&col, finished](const Motion& mo) { col.check(mo, finished); });
+    walker.run(p);
+  }
 }
 
 std::string ttpProgramText(const NotedProgram& p, parts::Dialect dialect) {

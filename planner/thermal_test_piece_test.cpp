@@ -51,10 +51,7 @@ double byHand(bool clockwise, double deg, double to) {
 }
 
 // A machine direction of a part direction at C (the simulator's convention, docs/conventions.md).
-Vector2d atC(const Vector2d& v, double c_deg, bool clockwise) {
-  const double a = degToRad((clockwise ? -1.0 : 1.0) * c_deg);
-  return {std::cos(a) * v.x() - std::sin(a) * v.y(), std::sin(a) * v.x() + std::cos(a) * v.y()};
-}
+Vector2d atC(const Vector2d& v, double c_deg, bool clockwise) { return parts::turnedByTable(v, c_deg, clockwise); }
 
 double segmentToOrigin(const Vector2d& a, const Vector2d& b) {
   const Vector2d ab = b - a;
@@ -262,7 +259,8 @@ TEST(ThermalTestPiecePlan, EveryMoveBelowTheTopStaysOutsideThePartAndCTurnsOnlyW
           if (x->x) to.x() = *x->x;
           if (x->y) to.y() = *x->y;
           if (x->z) to.z() = *x->z;
-          if (x->c) c_to = *x->c;
+        } else if (const auto* x = std::get_if<gcode::TurnC>(&op)) {
+          c_to = c + x->delta_deg;
         } else if (const auto* x = std::get_if<gcode::ProtectedMove>(&op)) {
           to = Vector3d(x->x, x->y, x->z);
         } else if (std::holds_alternative<gcode::ProbeMove>(op)) {
@@ -474,14 +472,18 @@ TEST(ThermalTestPiecePlan, TheCLoadTurnsWithinTheTurningSpeedAndFillsTheWait) {
   for (const auto& m : {nmv(), mill()}) {
     const auto plan = planThermalTestPiece(t, m, m.dialect);
     const double turning = m.c.max_turning_speed_rpm;
-    int c_feeds = 0;
+    std::vector<double> turns;
     for (const auto& op : program(plan, "test").program.ops)
-      if (const auto* f = std::get_if<gcode::Feed>(&op); f && f->c) {
-        ++c_feeds;
-        EXPECT_LE(f->feed / 360, turning + 1e-9);
-        EXPECT_FALSE(f->x || f->y || f->z);
+      if (const auto* f = std::get_if<gcode::TurnC>(&op)) {
+        turns.push_back(f->delta_deg);
+        EXPECT_LE(f->feed_deg_per_min / 360, turning + 1e-9);
       }
-    EXPECT_EQ(c_feeds, 2 * 4);  // forward and back inside each warm-up's loop
+    ASSERT_EQ(turns.size(), 2u * 4);  // forward and back inside each warm-up's loop
+    for (std::size_t i = 0; i < turns.size(); i += 2) {
+      EXPECT_GT(turns[i], 0);
+      EXPECT_EQ(turns[i + 1], -turns[i]);  // C back where it started after every pair
+      EXPECT_NEAR(std::fmod(turns[i], 360.0), 0, 1e-9);
+    }
     ASSERT_EQ(plan.loads.size(), 8u);
     for (const auto& l : plan.loads) {
       if (l.phase == "hold") {
@@ -504,7 +506,10 @@ TEST(ThermalTestPiecePlan, TheCLoadTurnsWithinTheTurningSpeedAndFillsTheWait) {
   const auto plan = planThermalTestPiece(t2, nmv(), parts::Dialect::FanucMacroB);
   EXPECT_EQ(plan.loads[0].turns_per_move, 277);
   EXPECT_NEAR(plan.loads[0].pairs * 2 * plan.loads[0].move_s + plan.loads[0].dwell_s, t.wait_s, 1e-3);
-  EXPECT_NE(ttpProgramText(program(plan, "test"), parts::Dialect::FanucMacroB).find("G1 C99720.000 F432000.000"), std::string::npos);
+  const std::string text = ttpProgramText(program(plan, "test"), parts::Dialect::FanucMacroB);
+  EXPECT_NE(text.find("WHILE [#101 LE " + std::to_string(plan.loads[0].pairs) + "] DO1\nG91 G1 C99720.000 F432000.000\nG90\nG91 G1 C-99720.000 F432000.000\nG90\n"
+                      "#101=#101+1\nEND1\n"),
+            std::string::npos);
 }
 
 // Runs the emitted texts through our interpreter on a machine that keeps the simulator's clock
@@ -527,15 +532,14 @@ struct ClockMachine : gcode::MachineInterface {
     pos.xyz_mm = Vector3d(m.c_axis_centre_mm.x(), m.c_axis_centre_mm.y(), m.z.max_mm);
   }
   gcode::MachinePosition start() const override { return pos; }
-  double rot(double d, const parts::RotaryAxis& a) const { return std::fabs(d) / (a.max_speed_rpm * 360) * 60; }
+  // The clock: the planner's one copy of the simulator's (planner/program_walker.hpp).
   void rapid(const gcode::MachinePosition& to) override {
-    time += std::max({(to.xyz_mm - pos.xyz_mm).cwiseAbs().maxCoeff() / m.rapid_feed_mm_per_min * 60,
-                      rot(to.c_deg - pos.c_deg, m.c), m.b.present ? rot(to.b_deg - pos.b_deg, m.b) : 0.0});
+    time += rapidSeconds(m, to.xyz_mm - pos.xyz_mm, to.b_deg - pos.b_deg, to.c_deg - pos.c_deg);
     pos = to;
   }
   void feed(const gcode::MachinePosition& to, double F) override {
     const double len = (to.xyz_mm - pos.xyz_mm).norm();
-    time += (len > 0 ? len : std::fabs(to.c_deg - pos.c_deg)) / F * 60;
+    time += len > 0 ? linearFeedSeconds(len, F) : rotaryFeedSeconds(to.c_deg - pos.c_deg, F);
     feed_turn_deg.push_back(to.c_deg - pos.c_deg);
     pos = to;
     feed_end_s.push_back(time);
@@ -551,14 +555,14 @@ struct ClockMachine : gcode::MachineInterface {
         o.contact = true;
         o.stop = to;
         o.stop.xyz_mm = p.contact_mm + Vector3d(0, 0, L);
-        time += (o.stop.xyz_mm - pos.xyz_mm).norm() / F * 60;
+        time += linearFeedSeconds((o.stop.xyz_mm - pos.xyz_mm).norm(), F);
         trigger_s.push_back(time);
         ++next_point;
         pos = o.stop;
         return o;
       }
     }
-    time += (to.xyz_mm - pos.xyz_mm).norm() / F * 60;  // a protected move: nothing touched
+    time += linearFeedSeconds((to.xyz_mm - pos.xyz_mm).norm(), F);  // a protected move: nothing touched
     o.stop = to;
     pos = to;
     return o;
@@ -655,4 +659,265 @@ TEST(ThermalTestPiecePlan, DeterministicAndAllFacetsPreCutOnce) {
   EXPECT_EQ(a.manifest.kind, "thermal_test_piece");
   EXPECT_EQ(a.manifest.ttp.cmm_plan, "cmm_points.csv");
   EXPECT_EQ(a.manifest.features.size(), 4u + 9 + 36);
+}
+
+// Review fixes (issue 13 follow-up): rollover, layouts that cannot be made, tool changes, the
+// C travel of C feeds, the G0 and tool-change rules, the strips the facet cuts re-cut.
+
+// A C axis with rollover (Fanuc ROA, LinuxCNC WRAPPED_ROTARY) and one without run the same
+// programs to the same table angles: every C feed is an incremental move of the commanded
+// amount, every absolute C word lies in [0, 360) (a rollover control may take it the short
+// way), so the table stands alike at every cut and every probing move.
+TEST(ThermalTestPiecePlan, TheTableTurnsAlikeWithAndWithoutCRollover) {
+  const auto t = piece();
+  for (const auto& m : {nmv(), mill()}) {
+    const auto plan = planThermalTestPiece(t, m, m.dialect);
+    auto wrap = [](double a) { return std::fmod(std::fmod(a, 360.0) + 360.0, 360.0); };
+    double linear = 0, physical = 0, fed = 0;  // C without rollover; the table's angle with it
+    int compared = 0, band_turns = 0;
+    for (const auto& p : plan.programs)
+      for (std::size_t i = 0; i < p.program.ops.size(); ++i) {
+        const auto& op = p.program.ops[i];
+        if (const auto* r = std::get_if<gcode::RotateC>(&op)) {
+          EXPECT_GE(r->c_deg, 0);
+          EXPECT_LT(r->c_deg, 360);
+          linear = r->c_deg;
+          double d = wrap(r->c_deg - wrap(physical));  // rollover: the shorter way to the word
+          if (d > 180) d -= 360;
+          physical += d;
+        } else if (const auto* f = std::get_if<gcode::TurnC>(&op)) {
+          linear += f->delta_deg;
+          physical += f->delta_deg;
+          fed += std::fabs(f->delta_deg);
+          if (p.notes[i].cut) {
+            ++band_turns;
+            EXPECT_EQ(f->delta_deg, 360);
+          }
+        }
+        if (p.notes[i].cut || std::holds_alternative<gcode::ProbeMove>(op)) {
+          ++compared;
+          const double d = std::fabs(wrap(linear) - wrap(physical));
+          EXPECT_LT(std::min(d, 360 - d), 1e-9) << p.file << ": " << p.notes[i].where;
+        }
+      }
+    EXPECT_EQ(band_turns, 4);
+    EXPECT_GT(compared, 400);
+    // The loads turn the table on a rollover axis too (loops written once: per pass).
+    double planned = 4 * 360.0;  // the bands
+    for (const auto& l : plan.loads) planned += l.rpm > 0 ? 2.0 * l.turns_per_move * 360.0 : 0.0;
+    EXPECT_NEAR(fed, planned, 1e-6);
+    // In the texts: every feed of C is G91 ... then G90 at once; no other line holds G91.
+    for (const auto d : {parts::Dialect::LinuxCnc, parts::Dialect::FanucMacroB})
+      for (const auto& p : plan.programs) {
+        std::istringstream in(ttpProgramText(p, d));
+        std::string line, prev;
+        const std::regex c_word(R"(\bC-?\d)");
+        while (std::getline(in, line)) {
+          const std::string code = line.substr(0, line.find('('));
+          if (code.rfind("G1 ", 0) == 0) {
+            EXPECT_FALSE(std::regex_search(code, c_word)) << p.file << ": " << line;
+          }
+          if (code.find("G91") != std::string::npos) {
+            EXPECT_EQ(code.rfind("G91 G1 C", 0), 0u) << line;
+          }
+          if (prev.rfind("G91", 0) == 0) {
+            EXPECT_EQ(code, "G90") << p.file << " after " << prev;
+          }
+          prev = code;
+        }
+      }
+  }
+}
+
+TEST(ThermalTestPiecePlan, ACFeedBeyondTheTravelOfANonContinuousCIsRefused) {
+  const auto t = piece();
+  auto m = nmv();
+  m.c.continuous = false;
+  m.c.min_deg = -360;
+  m.c.max_deg = 360;  // the bands (0 -> 360) fit, the load's 200 turns do not
+  try {
+    planThermalTestPiece(t, m, parts::Dialect::FanucMacroB);
+    FAIL();
+  } catch (const SafetyError& e) {
+    EXPECT_NE(std::string(e.what()).find("thermal_test.nc: load before test cycle 1: C turns forward: C feed move needs "
+                                         "C = 72000.000 deg, outside the C travel [-360.000, 360.000]"),
+              std::string::npos)
+        << e.what();
+  }
+  m.c.max_deg = 359;  // not even one band turn
+  try {
+    planThermalTestPiece(t, m, parts::Dialect::FanucMacroB);
+    FAIL();
+  } catch (const SafetyError& e) {
+    EXPECT_NE(std::string(e.what()).find("pre_machining.nc: band d202: one turn of C: C feed move needs C = 360.000 deg"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(ThermalTestPiecePlan, LayoutsThatCannotBeMadeAreRefusedNamingTheKeyNeverWrittenAsNan) {
+  // A 176 mm notch cuts the first facets of every segment away (and leaves no room for TOP
+  // points: asin > 1); it used to write "Xnan".
+  auto t = piece();
+  t.x_notch_width_mm = 176;
+  try {
+    planThermalTestPiece(t, nmv(), parts::Dialect::FanucMacroB);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("thermal_test_piece.yaml: pre_machining.x_notch.width: 176 mm cuts facet X1_1 away: "
+                                         "its centre (x 78.38, y 58.00 mm) lies in the notch (|y| < 88 mm)"),
+              std::string::npos)
+        << e.what();
+  }
+  t = piece();
+  t.y_notch_width_mm = 20;  // X1_9's centre at x 9.35
+  try {
+    planThermalTestPiece(t, nmv(), parts::Dialect::FanucMacroB);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("pre_machining.y_notch.width: 20 mm cuts facet X1_9 away"), std::string::npos) << e.what();
+  }
+  // A probe tip so large that no TOP point keeps a tip diameter from the notch and the facets.
+  auto m = nmv();
+  m.probe.tip_diameter_mm = 40;
+  try {
+    planThermalTestPiece(piece(), m, parts::Dialect::FanucMacroB);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("pre_machining.x_notch.width: 110 mm: no room on the top for the inspection's TOP points"),
+              std::string::npos)
+        << e.what();
+  }
+  // Nothing non-finite gets into a program: NotedProgram::add refuses it.
+  NotedProgram p;
+  p.file = "x.nc";
+  OpNote n;
+  n.where = "somewhere";
+  EXPECT_THROW(p.add(gcode::Rapid{NAN, 0, std::nullopt}, n), GeometryError);
+  EXPECT_THROW(p.add(gcode::TurnC{360, INFINITY}, n), GeometryError);
+  EXPECT_TRUE(p.program.ops.empty());
+}
+
+// The test's facet cuts run with the tool's bottom 0.1 mm below the notch floor: where a facet's
+// chord passes over the notch they re-cut the floor. Z-path points there are refused.
+TEST(ThermalTestPiecePlan, ZPathPointsOnTheStripsTheFacetCutsReCutAreRefused) {
+  auto t = piece();
+  t.z_path_points_along_mm = {-85, -50, -20, 20, 50, 85};
+  try {
+    planThermalTestPiece(t, nmv(), parts::Dialect::FanucMacroB);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("inspection.z_path_points.along: the point x 85 y 51 mm of Z path Z9 lies in the strip of "
+                                         "notch floor the test's cuts of facet X1_1 re-cut at the cutting height"),
+              std::string::npos)
+        << e.what();
+  }
+  // The shipped points: x +-80 at y +-51 stay 2.86 mm off the strips of X1_1, Y1_1, X2_1, Y2_1.
+  const auto plan = planThermalTestPiece(piece(), nmv(), parts::Dialect::FanucMacroB);
+  const double r = t.tool(t.test_tool)->diameter_mm / 2, a = t.facet_apothem_mm;
+  double closest = INFINITY;
+  for (const auto& p : plan.manifest.points) {
+    if (plan.manifest.feature(p.feature)->nominal.role != "z_path") continue;
+    const Vector2d q = (p.contact_mm - plan.manifest.part_origin_mm).head<2>();  // C 0: part frame
+    for (const auto& f : plan.manifest.features) {
+      if (f.nominal.role != "facet") continue;
+      const Vector2d n = f.nominal.direction.head<2>(), u(-n.y(), n.x());
+      const double along = std::clamp(q.dot(u), -t.facet_path_half_length_mm, t.facet_path_half_length_mm);
+      closest = std::min(closest, (q - ((a + r) * n + along * u)).norm() - r);
+    }
+  }
+  EXPECT_NEAR(closest, 2.855, 1e-3);
+}
+
+// A face tool other than the band tool (and a facet tool other than the X notch's): the spindle
+// stops before each change, and the header lists every tool.
+TEST(ThermalTestPiecePlan, EveryToolChangeComesWithTheSpindleStoppedAndEveryToolIsListed) {
+  auto t = piece();
+  t.face_tool = 3;
+  t.face_stepover_mm = 10;
+  t.facet_pre_tool = 2;
+  for (const auto& m : {nmv(), mill()}) {
+    const auto plan = planThermalTestPiece(t, m, m.dialect);
+    const auto& pre = program(plan, "pre_machining");
+    for (int n : {1, 2, 3, 4}) {
+      bool listed = false;
+      for (const auto& h : pre.program.header) listed = listed || h.rfind("T" + std::to_string(n) + ": ", 0) == 0;
+      EXPECT_TRUE(listed) << "T" << n;
+    }
+    for (auto d : {parts::Dialect::LinuxCnc, parts::Dialect::FanucMacroB}) {
+      std::istringstream in(ttpProgramText(pre, d));
+      std::string line;
+      bool turning = false;
+      int changes = 0;
+      while (std::getline(in, line)) {
+        if (line.find(" M3") != std::string::npos) turning = true;
+        if (line == "M5") turning = false;
+        if (line.find(" M6") != std::string::npos) {
+          ++changes;
+          EXPECT_FALSE(turning) << line;
+        }
+      }
+      EXPECT_EQ(changes, 7);  // T1 bands, T3 face, T4 mark, T2 Y notch, T1 X notch, T2 facets, T0
+    }
+    // The face passes are T3's cuts.
+    for (const auto& c : plan.manifest.cuts) {
+      if (c.feature == "TOP") {
+        EXPECT_EQ(c.tool, 3);
+      }
+    }
+  }
+}
+
+// The rules docs §5 lists as checked, on edited programs (checkThermalTestPiecePrograms walks
+// them with every check the planner makes).
+TEST(ThermalTestPiecePlan, AG0OfSeveralAxesBelowTheTopAndAToolChangeAwayFromItsHeightAreRefused) {
+  const auto t = piece();
+  const auto m = mill();
+  const auto plan = planThermalTestPiece(t, m, parts::Dialect::LinuxCnc);
+  EXPECT_NO_THROW(checkThermalTestPiecePrograms(t, m, plan.programs));
+  auto edited = [&](const std::string& role, const std::string& where_starts, gcode::Op op, bool before = false) {
+    auto programs = plan.programs;
+    for (auto& p : programs) {
+      if (p.role != role) continue;
+      for (std::size_t i = 0; i < p.notes.size(); ++i)
+        if (p.notes[i].where.rfind(where_starts, 0) == 0) {
+          const std::size_t at = before ? i : i + 1;
+          p.program.ops.insert(p.program.ops.begin() + static_cast<long>(at), op);
+          OpNote n;
+          n.where = "edited";
+          p.notes.insert(p.notes.begin() + static_cast<long>(at), n);
+          break;
+        }
+    }
+    return programs;
+  };
+  // At the cutting height beside the part, a G0 in X and Y together (a Fanuc may dog-leg).
+  const double x = plan.manifest.part_origin_mm.x() - 135, y = plan.manifest.part_origin_mm.y() + 5;
+  try {
+    checkThermalTestPiecePrograms(t, m, edited("test", "test: down to the cutting height", gcode::Rapid{x, y, std::nullopt}));
+    FAIL();
+  } catch (const SafetyError& e) {
+    EXPECT_NE(std::string(e.what()).find("thermal_test.ngc: edited: G0 from X-130.000 Y0.000 Z54.900 to X-135.000 Y5.000 Z54.900 "
+                                         "moves 2 axes with the tool T3 below the top of the part"),
+              std::string::npos)
+        << e.what();
+  }
+  // One axis is straight on every control.
+  EXPECT_NO_THROW(checkThermalTestPiecePrograms(t, m, edited("test", "test: down to the cutting height",
+                                                             gcode::Rapid{x, std::nullopt, std::nullopt})));
+  // A tool change below the tool-change height.
+  try {
+    checkThermalTestPiecePrograms(t, m, edited("inspection", "inspection: probe in", gcode::Rapid{std::nullopt, std::nullopt, 300.0}, true));
+    FAIL();
+  } catch (const SafetyError& e) {
+    EXPECT_NE(std::string(e.what()).find("inspection.ngc: inspection: probe in: tool change T99 with the gauge line at Z 300.000 mm, "
+                                         "not at the tool-change height"),
+              std::string::npos)
+        << e.what();
+  }
+  // A number that is not finite, put into the ops behind add()'s back, is refused by the walk.
+  auto programs = plan.programs;
+  programs[1].program.ops.insert(programs[1].program.ops.begin() + 5, gcode::Rapid{NAN, 0.0, std::nullopt});
+  programs[1].notes.insert(programs[1].notes.begin() + 5, OpNote{});
+  EXPECT_THROW(checkThermalTestPiecePrograms(t, m, programs), SafetyError);
 }

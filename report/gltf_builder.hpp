@@ -17,6 +17,7 @@
 #include <limits>
 #include <locale>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -130,6 +131,32 @@ class GltfBuilder {
   }
 
   tinygltf::Model& model() { return model_; }
+
+  // The finished file: a root node (the Z-up frame turned to glTF's +Y up) over `children`,
+  // one scene holding it, `extras` on the scene (three.js surfaces those as userData) and on
+  // the asset (for tools that read the file), pretty-printed JSON with the buffer embedded.
+  std::string serialise(const std::string& root_name, std::vector<int> children, const std::string& scene_name,
+                        const tinygltf::Value& extras) {
+    tinygltf::Node root;
+    root.name = root_name;
+    root.rotation = kMachineToGltfRotation;
+    root.children = std::move(children);
+    model_.nodes.push_back(std::move(root));
+    tinygltf::Scene scene;
+    scene.name = scene_name;
+    scene.nodes = {static_cast<int>(model_.nodes.size()) - 1};
+    scene.extras = extras;
+    model_.scenes.push_back(std::move(scene));
+    model_.defaultScene = 0;
+    model_.asset.version = "2.0";
+    model_.asset.generator = "probeloop";
+    model_.asset.extras = extras;
+    std::ostringstream out;
+    tinygltf::TinyGLTF writer;
+    if (!writer.WriteGltfSceneToStream(&model_, out, /*prettyPrint=*/true, /*writeBinary=*/false))
+      throw std::runtime_error("glTF scene: tinygltf failed to serialise the model");
+    return out.str();
+  }
 
  private:
   template <class T>

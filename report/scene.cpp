@@ -203,30 +203,7 @@ std::string campaignSceneGltf(const parts::PlanManifest& manifest,
     if (c.cycle != reference_cycle)
       children.push_back(addErrorVectorNode(b, manifest, c, reference, exaggeration, mat.vectors));
 
-  tinygltf::Model& model = b.model();
-  tinygltf::Node root;
-  root.name = "machine frame (Z up, m)";
-  root.rotation = kMachineToGltfRotation;
-  root.children = std::move(children);
-  model.nodes.push_back(std::move(root));
-
-  tinygltf::Scene scene;
-  scene.name = "probeloop campaign";
-  scene.nodes = {static_cast<int>(model.nodes.size()) - 1};
-  // Asset extras for tools that read the file; scene extras because viewers such as
-  // three.js surface those (as userData) and drop the asset's.
-  scene.extras = extras(exaggeration, reference_cycle);
-  model.scenes.push_back(std::move(scene));
-  model.defaultScene = 0;
-  model.asset.version = "2.0";
-  model.asset.generator = "probeloop";
-  model.asset.extras = extras(exaggeration, reference_cycle);
-
-  std::ostringstream out;
-  tinygltf::TinyGLTF writer;
-  if (!writer.WriteGltfSceneToStream(&model, out, /*prettyPrint=*/true, /*writeBinary=*/false))
-    throw std::runtime_error("glTF scene: tinygltf failed to serialise the model");
-  return out.str();
+  return b.serialise("machine frame (Z up, m)", std::move(children), "probeloop campaign", extras(exaggeration, reference_cycle));
 }
 
 }  // namespace probeloop::report

@@ -585,7 +585,8 @@ void comparisonTable(Page& page, const Route& r) {
   const std::string against = text(*cmp, "against");
   page.html += "<h3>" + esc(r.label) + ": spans compared (Table 7.2 layout)</h3>\n<p class=\"note\">this: " +
                esc(r.file.empty() ? r.label : r.file) + "; against: " + esc(against.empty() ? kDash : against) +
-               "; reduction = (against \u2212 this) / against.</p>\n";
+               "; reduction = (this \u2212 against) / this, this run taken as the uncompensated one (UC) and the other as "
+               "the compensated one (C), as in seed 004 Table 7.2.</p>\n";
   if (rows.empty()) {
     page.html += "<p class=\"note\">No rows in the comparison.</p>\n";
     return;

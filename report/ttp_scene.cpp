@@ -313,9 +313,10 @@ std::string thermalTestPieceSceneGltf(const parts::PlanManifest& manifest, const
       children.push_back(addCylinderBand(b, "datum " + n.id + " (band \u00d8" + diameterText(n.radius_mm) + " mm)", n,
                                          datum_material));
     } else if (n.kind == "plane" && n.role == "datum_top" && n.half_u_mm > 0) {
-      // The top face is not a full disc (the notches cut through it): its outline only, which
-      // also hides nothing of the surfaces below it.
-      children.push_back(addCircle(b, "datum " + n.id + " (top face outline, \u00d8" + diameterText(n.half_u_mm) + " mm)",
+      // The finished top (its extent is the radius of the band that reaches it, not the
+      // blank's) is not a full disc (the notches cut through it): its outline only, which also
+      // hides nothing of the surfaces below it.
+      children.push_back(addCircle(b, "datum " + n.id + " (finished top outline, \u00d8" + diameterText(n.half_u_mm) + " mm)",
                                    n.half_u_mm, n.point_mm.z(), outline_material));
     } else if (n.kind == "plane" && n.half_u_mm > 0 && n.half_v_mm > 0) {
       children.push_back(addQuad(b, "datum " + n.id, n, datum_material));
@@ -350,27 +351,8 @@ std::string thermalTestPieceSceneGltf(const parts::PlanManifest& manifest, const
   }
   children.push_back(addColourBar(b, scale, outerRadiusMm(manifest)));
 
-  tinygltf::Model& model = b.model();
-  tinygltf::Node root;
-  root.name = "part frame (Z up, m)";
-  root.rotation = kMachineToGltfRotation;
-  root.children = std::move(children);
-  model.nodes.push_back(std::move(root));
-  tinygltf::Scene scene;
-  scene.name = "probeloop thermal test piece";
-  scene.nodes = {static_cast<int>(model.nodes.size()) - 1};
-  scene.extras = sceneExtras(exaggeration, reference, scale);
-  model.scenes.push_back(std::move(scene));
-  model.defaultScene = 0;
-  model.asset.version = "2.0";
-  model.asset.generator = "probeloop";
-  model.asset.extras = sceneExtras(exaggeration, reference, scale);
-
-  std::ostringstream out;
-  tinygltf::TinyGLTF writer;
-  if (!writer.WriteGltfSceneToStream(&model, out, /*prettyPrint=*/true, /*writeBinary=*/false))
-    throw std::runtime_error("thermal-test-piece scene: tinygltf failed to serialise the model");
-  return out.str();
+  return b.serialise("part frame (Z up, m)", std::move(children), "probeloop thermal test piece",
+                     sceneExtras(exaggeration, reference, scale));
 }
 
 }  // namespace probeloop::report

@@ -5,9 +5,11 @@
 // and no warning. Everything is in the part frame (docs/thermal-test-piece.md §1: origin on
 // the C axis in the finished top face, +Z up), in metres; the root node turns it so that
 // glTF viewers (+Y up) show +Z up. Content:
-// - "datum TOP (top face outline, Ø… mm)": the top face's outline, a circle of the TOP
-//   datum's half extent at its height; "datum FLANK_P", "datum FLANK_N": the notch flanks
-//   as grey quads; "datum CYL (band Ø… mm)": the datum band as a grey cylinder surface;
+// - "datum TOP (finished top outline, Ø… mm)": the finished top's outline, a circle of the
+//   TOP datum's half extent (the radius of the band that reaches the top: Ø199 mm on the
+//   shipped piece, not the blank's Ø203) at its height; "datum FLANK_P", "datum FLANK_N":
+//   the notch flanks as grey quads; "datum CYL (band Ø… mm)": the datum band as a grey
+//   cylinder surface;
 // - one quad per measured facet and Z path (a feature of the evaluation's "features" with a
 //   manifest feature of the same id and role facet or z_path), at its nominal place: point
 //   ± half_u·u ± half_v·v with v = direction × u; coloured by its change against its

@@ -148,10 +148,15 @@ TEST_F(TtpScene, OneQuadPerMeasuredFeatureWithNamesThatSayWhatTheyAre) {
   EXPECT_EQ(vectors, 45 - 5);  // the references (Z5 and the four facets 5) have none
   for (const char* name : {"facet X1_2 (cycle 2): -4.1 um", "facet X1_5 (reference, cycle 0)",
                            "Z path Z1 (cycle 1): depth +3.0 um", "Z path Z9 (cycle 8): depth +24.0 um",
-                           "datum TOP (top face outline, \u00d8203 mm)", "datum FLANK_P", "datum FLANK_N",
+                           "datum TOP (finished top outline, \u00d8199 mm)", "datum FLANK_P", "datum FLANK_N",
                            "datum CYL (band \u00d8201 mm)", "deviation X1_2 (x1000)",
                            "colour scale: blue -50.0 um ... grey 0 ... red +50.0 um (change against the reference)"})
     EXPECT_NE(findNode(model, name), nullptr) << name;
+  // The outline is the finished top (the TOP feature's extent), not the blank.
+  const auto* top = findNode(model, "datum TOP (finished top outline, \u00d8199 mm)");
+  ASSERT_NE(top, nullptr);
+  EXPECT_DOUBLE_EQ(manifest.feature("TOP")->nominal.half_u_mm, 99.5);
+  for (const auto& p : positions(model, *top)) EXPECT_NEAR(p.head<2>().norm(), 99.5e-3, 1e-7);
   // Fewer measured features: fewer quads.
   json partial = evaluation;
   partial["features"].erase(partial["features"].end() - 1);  // the last facet (Y2_9)

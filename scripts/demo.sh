@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# The main job on the shipped example: plan the sphere-artifact cycle for the thesis's
+# The main job on the shipped examples: plan the sphere-artifact cycle for the thesis's
 # machine (seed 004), run the emitted program on the virtual machine (thermal network, C-axis
 # duty, day/night hall, probe physics, tool changes: examples/truth_campaign.yaml), evaluate
-# the controller log, compare with the injected truth, and write the glTF scene.
+# the controller log, compare with the injected truth, and write the glTF scene; machine a
+# block; fit and diagnose an error model on 72 h; then the thermal test piece of seed 004
+# Ch. 7 from its description to E_X ... E_TTP with U, the R-test beside it and the model.
 # Outputs in out/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -69,6 +71,57 @@ probeloop model diagnose "$C/model.yaml" --part "$C/artifact.yaml" --report "$C/
 echo "-- TALC replay (seed 004 Ch. 6) on the same campaign, a 36 h calibration phase (it holds the door event at 30 h) --"
 probeloop model talc --inputs "$C/run/inputs.csv" --errors "$C/eval/errors.csv" --cp-h 36 | sed -n '5,8p' | sed 's/^/   /'
 echo
+echo "== 7. the thermal test piece (seed 004 Ch. 7): plan -> 8 h on the virtual machine -> CMM and on-machine -> E with U =="
+T=$OUT/ttp
+$PL plan parts/thermal_test_piece.yaml --machine parts/machines/nmv5000.yaml --out "$T/plan" | sed -n '1,11p' | sed 's/^/   /'
+$PL simulate "$T/plan/pre_machining.nc" "$T/plan/thermal_test.nc" "$T/plan/inspection.nc" --machine parts/machines/nmv5000.yaml \
+  --part parts/thermal_test_piece.yaml --truth examples/truth_thermal_test.yaml --cmm-points "$T/plan/cmm_points.csv" \
+  --out "$T/run" --seed 1 | sed 's/^/   /'
+$PL evaluate "$T/run/cmm_export.csv" --manifest "$T/plan/plan.json" --out "$T/cmm" --scene "$T/cmm/test_piece.gltf" |
+  sed -n '1,12p' | sed 's/^/   /'
+$PL evaluate "$T/run/dprnt.txt" --manifest "$T/plan/plan.json" --out "$T/om" > /dev/null
+echo "   E_Y and E_TTP against the injected values (as cut; route 1 CMM, route 2 on the machine):"
+python3 tests/integration/compare_ttp.py "$T/run/truth.json" "$T/cmm/errors.csv" "$T/om/errors.csv" |
+  awk '/^  EY_um|^  ETTP_um/{on=1} /^  EZ_um|^  EB_urad/{on=0} on || /route [12] \(/' | sed 's/^/   /'
+echo "-- the R-test beside it (the sphere cycle of step 1, hourly, under the same C load; seed 004 Fig. 7.10) --"
+R=$T/r-test
+mkdir -p "$R"
+sed -e 's/^  count: 12$/  count: 9/' -e 's/^  gap: 5 min .*/  gap: 3480 s/' parts/sphere_artifact.yaml > "$R/artifact.yaml"
+$PL plan "$R/artifact.yaml" --machine parts/machines/nmv5000.yaml --out "$R/plan" > /dev/null
+# The same physics with the steel sphere on the table, and the test's load as a duty: 4 h of C at
+# 1200 rpm from the end of the first sphere cycle, as the piece's warm-up starts after its references.
+t1=$(python3 -c "import json; print(round(json.load(open('$R/plan/plan.json'))['schedule']['cycle_time_s']))")
+{ sed 's/^artifact: .*/artifact: {node: table, alpha_um_per_m_K: 11.5}/' examples/truth_thermal_test.yaml
+  printf 'duty:\n  c_axis:\n    profile:\n      - {at: 0 s, speed: 0 rpm}\n      - {at: %s s, speed: 1200 rpm}\n      - {at: %s s, speed: 0 rpm}\n' \
+    "$t1" "$((t1 + 14400))"; } > "$R/truth.yaml"
+$PL simulate "$R/plan/sphere_cycle.nc" --machine parts/machines/nmv5000.yaml --part "$R/artifact.yaml" \
+  --truth "$R/truth.yaml" --out "$R/run" --seed 1 > /dev/null
+$PL evaluate "$R/run/points.csv" --manifest "$R/plan/plan.json" --out "$R/eval" > /dev/null
+# On the piece's clock: the R-test's load starts where the piece's warm-up starts.
+shift=$(python3 -c "import json; print(json.load(open('$T/plan/plan.json'))['cycles'][0]['end_s'] - $t1)")
+awk -F, -v OFS=, -v s="$shift" '/^#/ || /^time_s/ {print; next} {$1 = $1 + s; print}' "$R/eval/errors.csv" > "$R/errors_on_piece_clock.csv"
+$PL report ttp --evaluation "$T/cmm/evaluation.json" --second "$T/om/evaluation.json" --r-test "$R/errors_on_piece_clock.csv" \
+  --html "$T/report.html" | sed 's/^/   /'
+echo "-- the model: what the table-side model misses on the piece (seed 004 L2226) --"
+{ echo "data: {inputs: run/inputs.csv, errors: cmm/errors.csv}"; cat <<'Y'
+kind: error_model
+channels:
+  EX_um: []
+  EY_um: [{effect: static, input: T_caxis_C}]
+  EZ_um: [{effect: static, input: T_caxis_C}]
+  ETTP_um: []
+Y
+} > "$T/model.yaml"
+probeloop model diagnose "$T/model.yaml" --part parts/thermal_test_piece.yaml > "$T/diagnosis.txt"
+sed -n '/^1\. /,/add it:/p' "$T/diagnosis.txt" | sed 's/^/   /'
+cmd=$(sed -n 's/^   add it: //p' "$T/diagnosis.txt" | head -1)
+echo "-- add it, as printed: $cmd"
+eval "$cmd" > /dev/null
+probeloop model fit "$T/model.yaml" --report "$T/fit.html" > "$T/fit.txt"
+sed -n '/^Before -> after/,$p' "$T/fit.txt" | grep -E 'Before|channel|ETTP' | sed 's/^/   /'
+
+echo
 echo "Outputs: $OUT/plan (G-code, manifest), $OUT/run (controller log, points.csv, inputs.csv, truth.json),"
 echo "         $OUT/eval (errors.csv, evaluation.json, report.md, campaign.gltf), $OUT/machining (cuts.json, cmm_export.csv),"
-echo "         $OUT/campaign (72 h: model.yaml, diagnosis-*.html, fit-*.html with the plots)"
+echo "         $OUT/campaign (72 h: model.yaml, diagnosis-*.html, fit-*.html with the plots),"
+echo "         $OUT/ttp (thermal test piece: plan/, run/, cmm/ and om/ evaluations, report.html, cmm/test_piece.gltf, r-test/, fit.html)"

@@ -39,7 +39,7 @@ std::vector<CmmPoint> readCmmPoints(const std::string& path) {
 }
 
 std::string measureOnCmm(const Stock& stock, const parts::Workpiece& w, const std::vector<CmmPoint>& points,
-                         const std::string& file, std::uint64_t seed, double search, double alpha_per_K) {
+                         const std::string& file, std::uint64_t seed, double alpha_per_K, double search) {
   std::mt19937_64 rng(seed ^ 0xC3A5C85C97CB3127ULL);
   std::normal_distribution<double> normal(0.0, 1.0);
   const double half_K = w.cmm.temperature_half_width_K;

@@ -38,7 +38,7 @@ std::vector<CmmPoint> readCmmPoints(const std::string& path);
 
 // alpha_per_K: the part's real expansion coefficient (NaN: the workpiece material's).
 std::string measureOnCmm(const Stock& stock, const parts::Workpiece& w, const std::vector<CmmPoint>& points,
-                         const std::string& points_file, std::uint64_t seed, double search_mm = 5.0,
-                         double alpha_per_K = std::numeric_limits<double>::quiet_NaN());
+                         const std::string& points_file, std::uint64_t seed,
+                         double alpha_per_K = std::numeric_limits<double>::quiet_NaN(), double search_mm = 5.0);
 
 }  // namespace probeloop::sim

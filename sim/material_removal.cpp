@@ -115,13 +115,14 @@ bool boxesOverlap(const Vector2d& alo, const Vector2d& ahi, const Vector2d& blo,
   return alo.x() <= bhi.x() && blo.x() <= ahi.x() && alo.y() <= bhi.y() && blo.y() <= ahi.y();
 }
 
-// Normalise an arc to counterclockwise [lo, lo + span], span <= one turn.
-void ccw(double start, double sweep, double& lo, double& span) {
-  span = std::min(std::fabs(sweep), kTwoPi);
-  lo = sweep >= 0 ? start : start - span;
-}
-
 }  // namespace
+
+CcwArc ccwArc(double start, double sweep) {
+  CcwArc a;
+  a.span = std::min(std::fabs(sweep), kTwoPi);
+  a.lo = sweep >= 0 ? start : start - a.span;
+  return a;
+}
 
 int Stock::cellX(double x) const {
   return std::clamp(static_cast<int>(std::floor((x - min_.x()) / cx_)), 0, nx_ - 1);
@@ -171,20 +172,26 @@ Removal Stock::removeHeightField(const Vector3d& p0, const Vector3d& p1, double 
   const double lo_y = std::min(a.y(), b.y()) - r, hi_y = std::max(a.y(), b.y()) + r;
   const int i0 = cellX(lo_x), i1 = cellX(hi_x), j0 = cellY(lo_y), j1 = cellY(hi_y);
   const double area = cx_ * cy_;
+  const double z_low = std::min(p0.z(), p1.z());
   Vector3d moment = Vector3d::Zero();
+  // Plain doubles in the loop (the same arithmetic as the vector forms): this is the hot
+  // path of every cut, and a Debug build does not inline Eigen's expressions.
+  const double ax = a.x(), ay = a.y(), abx = ab.x(), aby = ab.y();
   for (int j = j0; j <= j1; ++j)
     for (int i = i0; i <= i1; ++i) {
-      const Vector2d c(min_.x() + (i + 0.5) * cx_, min_.y() + (j + 0.5) * cy_);
-      const double t = plunge ? 0.0 : std::clamp((c - a).dot(ab) / L2, 0.0, 1.0);
-      if ((c - (a + t * ab)).norm() > r) continue;
-      const double zb = plunge ? std::min(p0.z(), p1.z()) : p0.z() + t * (p1.z() - p0.z());
       double& top = top_[static_cast<std::size_t>(j) * nx_ + i];
+      if (top <= z_low) continue;  // no material above the path's lowest point: nothing to remove
+      const double cx = min_.x() + (i + 0.5) * cx_, cy = min_.y() + (j + 0.5) * cy_;
+      const double t = plunge ? 0.0 : std::clamp(((cx - ax) * abx + (cy - ay) * aby) / L2, 0.0, 1.0);
+      const double dx = cx - (ax + t * abx), dy = cy - (ay + t * aby);
+      if (std::sqrt(dx * dx + dy * dy) > r) continue;
+      const double zb = plunge ? z_low : p0.z() + t * (p1.z() - p0.z());
       if (top <= zb || zb >= max_.z()) continue;
       const double from = std::max(zb, min_.z());
       if (top > from) {
         const double v = (top - from) * area;
         out.volume_mm3 += v;
-        moment += v * Vector3d(c.x(), c.y(), (top + from) / 2);
+        moment += v * Vector3d(cx, cy, (top + from) / 2);
       }
       top = zb <= min_.z() ? -kInf : zb;  // cut through: no material left in the column
     }
@@ -196,8 +203,7 @@ Removal Stock::removeHeightFieldArc(const Vector2d& centre, double rho, double s
                                     double r) {
   Removal out;
   if (nx_ == 0 || zb >= max_.z()) return out;
-  double lo = 0, span = 0;
-  ccw(start, sweep, lo, span);
+  const auto [lo, span] = ccwArc(start, sweep);
   const bool full = span >= kTwoPi - 1e-12;
   const Vector2d e0 = centre + rho * unit(lo), e1 = centre + rho * unit(lo + span);
   const double R = rho + r;
@@ -255,6 +261,11 @@ bool Stock::reachesBlank(const Vector2d& lo, const Vector2d& hi, double z_bottom
   return true;
 }
 
+bool Stock::segmentReachesBlank(const Vector3d& p0, const Vector3d& p1, double r) const {
+  const Vector2d lo = p0.head<2>().cwiseMin(p1.head<2>()) - Vector2d(r, r), hi = p0.head<2>().cwiseMax(p1.head<2>()) + Vector2d(r, r);
+  return reachesBlank(lo, hi, std::min(p0.z(), p1.z()));
+}
+
 bool Stock::recordCut(const Vector3d& p0, const Vector3d& p1, double r, double time_s, int tag) {
   const std::size_t before = cuts_.size();
   auto push = [&](const Vector3d& a, const Vector3d& b) {
@@ -293,8 +304,7 @@ bool Stock::recordCut(const Vector3d& p0, const Vector3d& p1, double r, double t
 
 bool Stock::recordArc(const Vector2d& centre, double rho, double start, double sweep, double zb, double r,
                       double time_s, int tag) {
-  double lo = 0, span = 0;
-  ccw(start, sweep, lo, span);
+  const auto [lo, span] = ccwArc(start, sweep);
   if (!(span > 0) || nx_ == 0) return false;
   // The annulus misses the blank: the tool went around it (or the blank around the tool).
   if (zb >= max_.z()) return false;
@@ -349,8 +359,10 @@ double Stock::topUnder(const Vector2d& xy, double r) const {
   const int i0 = cellX(xy.x() - r), i1 = cellX(xy.x() + r), j0 = cellY(xy.y() - r), j1 = cellY(xy.y() + r);
   for (int j = j0; j <= j1; ++j)
     for (int i = i0; i <= i1; ++i) {
-      const Vector2d c(min_.x() + (i + 0.5) * cx_, min_.y() + (j + 0.5) * cy_);
-      if ((c - xy).norm() <= r) best = std::max(best, top_[static_cast<std::size_t>(j) * nx_ + i]);
+      const double top = top_[static_cast<std::size_t>(j) * nx_ + i];
+      if (top <= best) continue;  // cannot raise it (a collision check's hot path: plain doubles)
+      const double dx = min_.x() + (i + 0.5) * cx_ - xy.x(), dy = min_.y() + (j + 0.5) * cy_ - xy.y();
+      if (std::sqrt(dx * dx + dy * dy) <= r) best = top;
     }
   return best;
 }

@@ -56,6 +56,13 @@ struct SweptArc {
   Eigen::Vector2d lo, hi;  // XY bounding box of the swept region
 };
 
+// An arc from start_rad by sweep_rad (positive counterclockwise) as the counterclockwise
+// [lo, lo + span] it covers, span at most one turn (a longer sweep covers one turn).
+struct CcwArc {
+  double lo = 0, span = 0;
+};
+CcwArc ccwArc(double start_rad, double sweep_rad);
+
 struct Removal {
   double volume_mm3 = 0;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  // of the removed material
@@ -71,6 +78,11 @@ class Stock {
   // Material absent from the start (a drilled hole): a vertical cylinder.
   void addHole(const Eigen::Vector2d& centre_mm, double radius_mm, double z_min_mm, double z_max_mm);
 
+  // Can a flat end mill of this radius on the segment p0-p1 reach the blank at all (the XY
+  // box of its swept region, its lowest bottom)? False: removeHeightField removes nothing and
+  // recordCut stores nothing, so a move in the air (the chords of a ring around the part)
+  // may skip both.
+  bool segmentReachesBlank(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, double radius) const;
   // The height field part: what the move from p0 to p1 removes (undisplaced tool path).
   Removal removeHeightField(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, double radius);
   // The same for a horizontal arc (tool-bottom centre at z_bottom on a circle of radius rho

@@ -39,7 +39,8 @@ parts::Workpiece cylinder(double radial_ratio = 0) {
   w.frame_origin_mm = Vector3d(0, 0, 40);
   w.obstacles.push_back({Vector2d(0, 0), 30, -40, -30, "adapter"});
   w.obstacles.push_back({Vector2d(70, 0), 5, -30, -5, "clamp 1"});
-  w.material = {"aluminium", 23.4e-6, 700, radial_ratio};
+  w.material = {.name = "aluminium", .alpha_per_K = 23.4e-6, .specific_cutting_force_N_per_mm2 = 700,
+                .radial_force_ratio = radial_ratio, .alpha_um_per_m_K = 23.4};
   parts::CuttingTool t;
   t.number = 1;
   t.diameter_mm = 10;
@@ -104,8 +105,11 @@ TEST(RotaryCut, AFullTurnLeavesTheCylinderRhoMinusR) {
   EXPECT_NEAR((*arc)["path_radius_mm"].get<double>(), 53, 1e-9);
   EXPECT_NEAR((*arc)["sweep_deg"].get<double>(), 360, 1e-9);
   EXPECT_NEAR((*arc)["z_mm"].get<double>(), -5, 1e-9);
-  // 360 deg at F3600 deg/min: 6 s.
-  EXPECT_GT(out.end_time_s, 6);
+  // The clock: the tool change (6 s on the NMV); the rapid from the start (gauge line at the
+  // top of Z, 660, above the axis) to X53 Y0 and the gauge line at Z 50 + 120 (tool length)
+  // = 170, the slowest axis Z over 490 mm at 6000 mm/min: 4.9 s; the plunge of 15 mm at
+  // F300: 3 s; 360 deg at F3600 deg/min: 6 s; the rapid up 15 mm: 0.15 s.
+  EXPECT_NEAR(out.end_time_s, 6 + 4.9 + 3 + 6 + 0.15, 1e-9);
 }
 
 // +C turns the table clockwise (the NMV's positive_rotation), so the part turns clockwise
@@ -183,6 +187,24 @@ TEST(RotaryCut, ObstaclesMayNotBeTouched) {
   // A cut into the clamp.
   expectRefusal([&] { run(kHead + "S8000 M3\nG0 X90 Y0 Z50\nG0 Z32\nG1 X60 F500\nM5\nM2\n", w, t); },
                 "mill.ngc:9: feed move (G1/G2/G3) would touch the clamp 1");
+}
+
+// A move of X/Y/Z together with C: in the part frame the tool follows a curve, which the
+// path checks do not follow. Below the top of the part it is refused as not modelled, even
+// where the curve would be clear (here beside the part, at z -8 below its top z 0); above the
+// top (z +10) nothing can be met: allowed, rapid and feed alike.
+TEST(TableTurn, XYZTogetherWithCBelowTheTopIsNotModelled) {
+  const auto w = cylinder();
+  const auto t = truthFrom("");
+  expectRefusal([&] { run(kHead + "G0 X80 Y30 Z50\nG0 Z32\nG0 X85 C20\nM2\n", w, t); },
+                "mill.ngc:8: rapid (G0) moves X/Y/Z and C together below the top of the part: not modelled");
+  expectRefusal([&] { run(kHead + "G0 X80 Y30 Z50\nG0 Z32\nG1 Y40 C-20 F500\nM2\n", w, t); },
+                "mill.ngc:8: feed move (G1/G2/G3) with the spindle stopped moves X/Y/Z and C together below the top of the part: "
+                "not modelled");
+  // Ending below the top counts too (the tool's bottom at the lower end).
+  expectRefusal([&] { run(kHead + "G0 X80 Y30 Z50\nG0 X85 Z32 C20\nM2\n", w, t); },
+                "mill.ngc:7: rapid (G0) moves X/Y/Z and C together below the top of the part");
+  EXPECT_NO_THROW(run(kHead + "G0 X80 Y30 Z50\nG0 X-40 Y10 C120\nG1 X40 C0 F500\nM2\n", w, t));
 }
 
 // F in deg/min for a move of C alone: 432000 deg/min is 1200 rpm, the NMV's turning speed;

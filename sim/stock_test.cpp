@@ -158,6 +158,26 @@ TEST(Stock, RampsAreSplitByHeightChange) {
   EXPECT_EQ(steep.sweptVolumes(), static_cast<std::size_t>(std::ceil(std::hypot(1.0, 10.0) / 0.05)));  // 201
 }
 
+// Whether a segment's swept region can reach the blank (the test that lets a move in the
+// air skip the height field) around the Ø100 x 30 cylinder, tool radius 5: a chord at
+// x = 130 (its box from x = 125) cannot, nor one with the tool's edge at x = 52 (2 mm beside
+// the blank's square), a pass above the top (bottom at z 0.1), or one whose box overlaps the
+// square's corner but not the circle (the box's point nearest the axis (40, 40) lies 56.6 mm
+// from it): that one removes nothing and stores nothing. A pass at z -1 across the top
+// reaches it and removes material.
+TEST(Stock, ASegmentInTheAirCannotReachTheBlank) {
+  Stock s(Vector3d(-50, -50, -30), Vector3d(50, 50, 0), 0.25, true);
+  const double r = 5;
+  EXPECT_FALSE(s.segmentReachesBlank(Vector3d(130, -10, -5), Vector3d(130, 10, -5), r));
+  EXPECT_FALSE(s.segmentReachesBlank(Vector3d(52 + r, -10, -5), Vector3d(52 + r, 10, -5), r));
+  EXPECT_FALSE(s.segmentReachesBlank(Vector3d(-60, 0, 0.1), Vector3d(60, 0, 0.1), r));
+  EXPECT_FALSE(s.segmentReachesBlank(Vector3d(45, 60, -5), Vector3d(60, 45, -5), r));
+  EXPECT_EQ(s.removeHeightField(Vector3d(45, 60, -5), Vector3d(60, 45, -5), r).volume_mm3, 0);
+  EXPECT_FALSE(s.recordCut(Vector3d(45, 60, -5), Vector3d(60, 45, -5), r, 0));
+  EXPECT_TRUE(s.segmentReachesBlank(Vector3d(-60, 0, -1), Vector3d(60, 0, -1), r));
+  EXPECT_GT(s.removeHeightField(Vector3d(-60, 0, -1), Vector3d(60, 0, -1), r).volume_mm3, 0);
+}
+
 // The height field's removal on an arc: the ring's volume (pi (R^2 - (rho - r)^2) x depth)
 // within the cells' resolution, and its mean radius between the ring's radii.
 TEST(Stock, HeightFieldRemovalOfAnArc) {

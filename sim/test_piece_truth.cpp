@@ -263,7 +263,7 @@ void writeTestPieceTruth(const TestPieceTruth& t, nlohmann::ordered_json& jt) {
       nlohmann::ordered_json m{{"time_s", cs->time_s}, {"tool", cs->tool}};
       for (int k = 0; k < 7; ++k) m[names[k]] = cs->location[static_cast<std::size_t>(k)];
       m["tool_um"] = vec(cs->tool_um);
-      m["part_dT_K"] = cs->part_dT_K;
+      m["part_above_20C_K"] = cs->part_above_20C_K;
       j["machine"] = m;
     } else {
       j["machine"] = nullptr;

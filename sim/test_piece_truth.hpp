@@ -20,6 +20,13 @@
 // - per cutting cycle (parts::cuttingCycles): parts::TtpMeasures of its Z path and four
 //   facets, and parts::ttpErrors against cycle 0; its time is the mean start time of the
 //   cuts that made its five surfaces.
+//
+// Why the datum frame, d, d_Z and beta are built here again rather than taken from evaluate/:
+// this is what the evaluation is checked against, so it must not share the evaluation's code
+// (an error there would then be on both sides and the comparison would pass); sim/ does not
+// depend on evaluate/ either. Only parts::ttpErrors, the thesis's formulas (Eqs. 7.1-7.5,
+// 7.9), is shared, and parts/thermal_test_piece_test.cpp checks it against hand derivations.
+// The fits themselves are geometry::fitElement, the library's least squares.
 #pragma once
 #include <Eigen/Dense>
 #include <array>
@@ -40,7 +47,7 @@ struct CutState {
   int tool = 0;
   std::array<double, 7> location{};                   // EX0C_um ... EC0C_urad
   Eigen::Vector3d tool_um = Eigen::Vector3d::Zero();  // tool-side translation
-  double part_dT_K = 0;                               // the part's node above its start
+  double part_above_20C_K = 0;  // the part's temperature above 20 °C (its expansion, and its support's)
 };
 
 struct AsCutFeature {

@@ -7,9 +7,13 @@
 // Every expectation is derived from the effect's definition.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
-#include <nlohmann/json.hpp>
+#include <cstdio>
+#include <cstdlib>
 #include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "core/csv.hpp"
@@ -28,6 +32,22 @@ using test::truthFrom;
 
 constexpr double kUm = 1e-6;  // um: the as-cut surfaces are exact, the fits of exact points too
 
+// Under the sanitizers (ASan + UBSan, a Debug build: ~50x slower) the whole test waits 10 min
+// between its cutting cycles instead of the shipped hour: the same code paths (pre-machining,
+// the C load's feed moves with the tool waiting below the top, the NC hold, the rings, nine
+// cycles) with a sixth of the load moves. A Release build runs the full 8 h.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kShortWait = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kShortWait = true;
+#else
+constexpr bool kShortWait = false;
+#endif
+#else
+constexpr bool kShortWait = false;
+#endif
+
 struct Setup {
   parts::Machine machine = parts::loadMachine(src("parts/machines/nmv5000.yaml"));
   parts::TestPiece piece;
@@ -38,13 +58,24 @@ struct Setup {
 // The shipped piece. Reduced (the default): two cutting cycles (reference: path/facet 5;
 // cycle 1: 1), pre-machining only what the datums need, without cutting forces (their
 // deflection differs between facets clipped differently by the notch, an effect of its own).
-// Forces off unless asked for. Full: the shipped nine cycles with the shipped load between them (an hour of C at 1200 rpm
-// as G1 C+-72000 moves with the tool waiting at (-130, 0) at the cutting height, or an hour's
-// NC hold), all four bands, the mark, both notches and the 36 pre-cut facets, forces on, and
-// a ring move (G2 about the axis at 130 mm) to the waiting position after each cycle.
+// Forces off unless asked for. Full: the shipped nine cycles with the shipped load between
+// them (the description's wait, an hour, 10 min under the sanitizers (kShortWait): C at 1200
+// rpm as incremental G91 G1 C+-72000 moves with the tool waiting at (-130, 0) at the cutting height, or an NC
+// hold), all four bands, the mark, both notches and the 36 pre-cut facets, and a ring move
+// (G2 about the axis at 130 mm) to the waiting position after each cycle.
 Setup setup(bool full = false, bool forces = false) {
   Setup s;
-  auto t = parts::loadThermalTestPiece(src("parts/thermal_test_piece.yaml"));
+  std::string description_file = src("parts/thermal_test_piece.yaml");
+  if (full && kShortWait) {
+    // The description's own text with the shorter wait (the loader checks it as any other).
+    std::ifstream in(description_file);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string from = "wait: 1 h", to = "wait: 10 min";
+    const auto at = text.find(from);
+    if (at == std::string::npos) throw std::runtime_error("no '" + from + "' in " + description_file);
+    description_file = test::writeTemp("thermal_test_piece.yaml", text.replace(at, from.size(), to));
+  }
+  auto t = parts::loadThermalTestPiece(description_file);
   if (!full) {
     t.order = {5, 1};
     t.load = {{"warm_up", 1, 1200}};
@@ -55,7 +86,7 @@ Setup setup(bool full = false, bool forces = false) {
   s.piece.stock = parts::thermalTestPieceWorkpiece(t);
   s.piece.description = t;
   const Vector3d o = parts::partOriginOnMachine(t, s.machine.c_axis_centre_mm, s.machine.table_surface_z_mm);
-  const double sense = s.machine.c.positive_is_clockwise ? -1.0 : 1.0;  // part angle th shows at th + sense C
+  const double sense = parts::tableTurnSign(s.machine.c.positive_is_clockwise);  // part angle th shows at th + sense C
   auto X = [&](double x) { return " X" + formatNumber(x + o.x(), 6); };
   auto Y = [&](double y) { return " Y" + formatNumber(y + o.y(), 6); };
   auto Z = [&](double z) { return " Z" + formatNumber(z + o.z(), 6); };
@@ -181,6 +212,20 @@ Gap gap(const nlohmann::json& truth) {
   return {last0, first1};
 }
 
+// How much deeper than a ramp tilted by theta along its path a flat end mill that stays
+// horizontal in the part frame leaves the floor, per unit theta, as the truth's plane fit
+// sees it (the EB0C test): the mean of sqrt(r^2 - y^2) over its sample rows, y = 0 and
+// +-0.8 of the path's nominal half width (three rows: the half width, r, is under 10 mm).
+double floorRowsDepth(const Setup& s) {
+  const double r = s.ttp().tool(s.ttp().test_tool)->diameter_mm / 2;
+  double half_v = 0;
+  for (const auto& f : s.piece.features)
+    if (f.id == "Z1") half_v = f.half_v_mm;
+  EXPECT_NEAR(half_v, r, 1e-12);
+  const double y = 0.8 * half_v;
+  return (2 * std::sqrt(r * r - y * y) + r) / 3;
+}
+
 TEST(TtpTruth, WithoutEffectsEveryErrorIsZero) {
   const auto s = setup();
   const auto j = simulate(s, truthFrom(""));
@@ -230,6 +275,76 @@ TEST(TtpTruth, ATableShiftInXIsEX) {
   EXPECT_NEAR(feature(j, "X1_5")["machine"]["EX0C_um"].get<double>(), 0, 1e-12);
 }
 
+// EY0C steps by +e = 4 um between the cycles. Y1 is cut on the machine's +Y side moving -X:
+// the table shifted +e in Y brings it e closer to the axis (d_Y1 - e); Y2 on the -Y side lies
+// e farther (d_Y2 + e); the X facets are cut along Y, which the shift only moves along
+// themselves, and the Z path along X keeps its depth. E_Y = (dd_Y2 - dd_Y1) / 2 = +e (Eq. 7.2
+// sign corrected); E_X, E_Z, E_B, E_TTP stay 0.
+TEST(TtpTruth, ATableShiftInYIsEY) {
+  const auto s = setup();
+  const Gap g = gap(simulate(s, truthFrom("")));
+  const double t = g.from_s + 600;
+  ASSERT_LT(t + 1, g.to_s);
+  const auto j = simulate(s, truthFrom("location_keyframes: [{time: " + formatNumber(t) + " s}, {time: " + formatNumber(t + 1) +
+                                       " s, EY0C_um: 4}]\n"));
+  const auto& c1 = j["ttp_cycles"][1];
+  EXPECT_NEAR(c1["EY_um"].get<double>(), 4, kUm);
+  for (const char* e : {"EX_um", "EZ_um", "EB_urad", "ETTP_um", "ETTP_7_9_um"}) EXPECT_NEAR(c1[e].get<double>(), 0, kUm) << e;
+  EXPECT_NEAR(feature(j, "Y1_1")["as_cut"]["d_mm"].get<double>(), 97.5 - 0.004, 1e-9);
+  EXPECT_NEAR(feature(j, "Y2_1")["as_cut"]["d_mm"].get<double>(), 97.5 + 0.004, 1e-9);
+  EXPECT_NEAR(feature(j, "Y1_1")["machine"]["EY0C_um"].get<double>(), 4, 1e-12);
+}
+
+// EB0C steps by theta = 20 urad between the cycles: the table (and the part) tilted right-
+// handedly about +Y through the C axis at the table surface. A point h above the pivot at
+// machine x lies in the table at x' = x cos(theta) - h sin(theta), z' = x sin(theta) +
+// h cos(theta) (R_y(-theta) applied to it). The tool tip cuts at h = H = adapter 40 + washers
+// 3 + finished height 24 - 12.1 = 54.9 mm above the table:
+// - the Z path, cut along +X, rises by theta per mm of x in the part: its floor's normal is
+//   (-theta, 0, 1), beta = atan2(n_x, n_z) = -theta, so E_B = -theta (docs/thermal-test-
+//   piece.md §4). The tool's flat bottom stays horizontal in the part frame (the simulator
+//   does not tilt the tool with the table, docs/simulator.md §5), so at a distance y from the
+//   path's centre line the floor is the lowest point of the ramp within sqrt(r^2 - y^2) of
+//   x: theta sqrt(r^2 - y^2) deeper than the ramp. The truth samples the floor on three rows
+//   (the path's nominal half width is r = 6 mm, < 10 mm) at y = 0, +-0.8 r = +-4.8 mm
+//   (sqrt(36 - 4.8^2) = 3.6): the fitted plane lies theta (3.6 + 6 + 3.6) / 3 = 4.4 theta
+//   deeper at the centre, E_Z = 4.4 mm x theta = 0.088 um, less up to delta (below); the
+//   tip's own height at x' = 0 moves by H (1/cos(theta) - 1), 1e-8 um;
+// - X1, cut at x = a + r, comes H sin(theta) closer to the axis, X2 at -(a + r) as much
+//   farther: E_X = H sin(theta) = 1.098 um, an Abbe offset of the tilt (the lever from the
+//   pivot to the tip); both come (a + r)(1 - cos(theta)) = 2e-5 um closer: the E_TTP of it;
+// - the Y facets, cut along X, do not move (y' = y).
+// The floor is a ramp in the part, stored as horizontal pieces at their upper Z, each
+// changing z by at most delta = 1e-5 mm (docs/simulator.md §2.4): a least-squares slope
+// through such a staircase on sample points x_i is off by at most
+// (delta / 2) sum |x_i - mean| / sum (x_i - mean)^2, for samples evenly spread over a span L
+// 1.5 delta / L; the reference's floor is flat. The depth lies up to delta higher (pieces at
+// their upper Z).
+TEST(TtpTruth, ATableTiltAboutYIsMinusEB) {
+  const auto s = setup();
+  const Gap g = gap(simulate(s, truthFrom("")));
+  const double t = g.from_s + 600;
+  ASSERT_LT(t + 1, g.to_s);
+  const double theta = 20e-6;
+  const auto j = simulate(s, truthFrom("location_keyframes: [{time: " + formatNumber(t) + " s}, {time: " + formatNumber(t + 1) +
+                                       " s, EB0C_urad: 20}]\n"));
+  const double H = 40 + 3 + 24 - 12.1, a = 97.5, r = 6, delta = 1e-5;
+  ASSERT_NEAR(s.ttp().supportHeight() + s.ttp().finishedHeight() + s.ttp().cuttingZ(), H, 1e-12);
+  double half_u = 0;  // Z1's half length: the samples span 80 % of it each way
+  for (const auto& f : s.piece.features)
+    if (f.id == "Z1") half_u = f.half_u_mm;
+  const double slope_bound = 1.5 * delta / (1.6 * half_u);
+  const double rows = floorRowsDepth(s);
+  EXPECT_NEAR(rows, 4.4, 1e-12);
+  const auto& c1 = j["ttp_cycles"][1];
+  EXPECT_NEAR(c1["EB_urad"].get<double>(), -theta * 1e6, slope_bound * 1e6);
+  EXPECT_NEAR(c1["EX_um"].get<double>(), H * std::sin(theta) * 1e3, kUm);
+  EXPECT_NEAR(c1["ETTP_um"].get<double>(), (a + r) * (std::cos(theta) - 1) * 1e3, kUm);
+  EXPECT_NEAR(c1["EY_um"].get<double>(), 0, kUm);
+  EXPECT_NEAR(c1["EZ_um"].get<double>(), (rows * theta - delta / 2) * 1e3, delta / 2 * 1e3);
+  EXPECT_NEAR(feature(j, "Z1")["machine"]["EB0C_urad"].get<double>(), 20, 1e-12);
+}
+
 // The tool grows 5 um along +Z between the cycles (a column node following a +1 K step of
 // the hall within milliseconds, 5 um/K): Z path 1 is cut 5 um shallower, E_Z = d_Z(t1) -
 // d_Z(t0) = -5 um; the facets, cut by the tool's flank, do not move.
@@ -254,8 +369,14 @@ thermal:
 // axis (radius r) leaves a facet at a / k, k = 1 + alpha dT (expansion about the datum on the
 // axis): each facet comes a alpha dT / k closer, so Eq. 7.3's E_TTP = (dl_X + dl_Y) / 2 =
 // -2 a alpha dT / k (-2 alpha dT a to first order, 2.7 nm apart), Eq. 7.9 half of it, E_X =
-// E_Y = 0. The Z path, cut with the tool's bottom 11.9 mm above the datum (the blank's bottom,
-// z -24), comes out at -24 + 11.9 / k: 11.9 alpha dT / k deeper below the (cold) top: E_Z > 0.
+// E_Y = 0. The Z path: the tool's tip is H = S + h = 54.9 mm above the table, S = adapter 40
+// + washers 3 = 43 mm, h = 24 - 12.1 = 11.9 mm the path's height above the piece's bottom
+// (the datum). The support (the part's alloy, at its temperature) has lifted the bottom by
+// alpha dT S and the part has grown about it by k: the tool cuts H - S k above the warm
+// bottom, which is H / k - S above it at 20 C. The cold top is 24 above the bottom, so the
+// path's depth is 24 + S - H / k against the cold reference's 24 + S - H: E_Z = H (1 - 1/k)
+// = alpha dT (S + h) / k, the path lies deeper at 20 C (the lever parts::expansionLevers
+// gives for E_Z).
 TEST(TtpTruth, AWarmPartIsMinusTwoAlphaDTa) {
   const auto s = setup();
   const Gap g = gap(simulate(s, truthFrom("")));
@@ -274,21 +395,56 @@ artifact: {node: part, alpha_um_per_m_K: 23.4}
   EXPECT_NEAR(c1["ETTP_7_9_um"].get<double>(), -a * alpha * dT / k * 1e3, kUm);
   EXPECT_NEAR(c1["EX_um"].get<double>(), 0, kUm);
   EXPECT_NEAR(c1["EY_um"].get<double>(), 0, kUm);
-  const double above_datum = s.ttp().finishedHeight() + s.ttp().cuttingZ();  // 24 - 12.1 = 11.9
-  EXPECT_NEAR(c1["EZ_um"].get<double>(), above_datum * alpha * dT / k * 1e3, kUm);
-  EXPECT_NEAR(feature(j, "X1_1")["machine"]["part_dT_K"].get<double>(), dT, 1e-9);
+  const double S = 40 + 3, h = 24 - 12.1;
+  ASSERT_NEAR(s.ttp().supportHeight(), S, 1e-12);
+  ASSERT_NEAR(s.ttp().finishedHeight() + s.ttp().cuttingZ(), h, 1e-12);
+  EXPECT_NEAR(c1["EZ_um"].get<double>(), alpha * dT * (S + h) / k * 1e3, kUm);
+  EXPECT_NEAR(parts::expansionLevers(s.piece).length_mm.at("EZ"), S + h, 1e-12);
+  EXPECT_NEAR(feature(j, "X1_1")["machine"]["part_above_20C_K"].get<double>(), dT, 1e-9);
+  EXPECT_NEAR(feature(j, "X1_5")["machine"]["part_above_20C_K"].get<double>(), 0, 1e-9);
+}
+
+// A hall at 21 C all along (the part's node starts there and stays: it rises by 0 K): every
+// cut is made with the part 1 K above 20 C, which the machine state records
+// (part_above_20C_K = 1, the temperature its expansion follows, not the rise since t = 0).
+// Measured at 20 C, k = 1 + alpha: the facets lie at a / k, the datum circle at 100.5 / k. A
+// cut made with the tip H' above the table lies at z = H' / k - S - 24 in the part frame at
+// 20 C (the bottom at -24, lifted by S (k - 1) and grown about by k, as in the warm-part
+// test): the top, faced at H' = S + 24 = 67, at 67 / k - 67, the Z paths (H' = 54.9) at
+// 54.9 / k - 67, so their depth is 12.1 / k. Every cycle is cut at the same temperature:
+// every E is 0.
+TEST(TtpTruth, APartCutAt21CIsMeasuredAt20C) {
+  const auto s = setup();
+  const auto j = simulate(s, truthFrom(R"(
+thermal:
+  environment: {mean_C: 21}
+  nodes: [{name: part, capacity_J_per_K: 1, to_environment_W_per_K: 1000}]
+artifact: {node: part, alpha_um_per_m_K: 23.4}
+)"));
+  const double k = 1 + 23.4e-6;
+  for (const char* id : {"X1_5", "Y2_1", "Z1", "TOP", "CYL"})
+    EXPECT_NEAR(feature(j, id)["machine"]["part_above_20C_K"].get<double>(), 1, 1e-9) << id;
+  for (const auto& side : {FacetSide::X1, FacetSide::Y1, FacetSide::X2, FacetSide::Y2})
+    for (int f : {5, 1}) EXPECT_NEAR(feature(j, parts::facetId(side, f))["as_cut"]["d_mm"].get<double>(), 97.5 / k, 1e-9);
+  EXPECT_NEAR(feature(j, "CYL")["as_cut"]["radius_mm"].get<double>(), 100.5 / k, 1e-9);
+  for (const char* id : {"Z5", "Z1"}) EXPECT_NEAR(feature(j, id)["as_cut"]["depth_mm"].get<double>(), 12.1 / k, 1e-9);
+  const auto& c1 = j["ttp_cycles"][1];
+  for (const char* e : {"EX_um", "EY_um", "EZ_um", "EB_urad", "ETTP_um"}) EXPECT_NEAR(c1[e].get<double>(), 0, kUm) << e;
 }
 
 // The whole test as the thesis runs it (9 cycles, 4 h of C at 1200 rpm = 1440 rotary feed
-// moves with the tool waiting below the top, 4 h hold, ring moves of ~1200 chords each): the
-// simulator carries it (in seconds in a Release build) and, without effects, every cycle's
-// errors are 0 and every facet and Z path of the test lies where the drawing puts it.
+// moves with the tool waiting below the top, 4 h hold, ring moves of ~1200 chords each; under
+// the sanitizers 10 min waits): the simulator carries it (in a fraction of a second in a
+// Release build) and, without effects, every cycle's errors are 0 and every facet and Z path
+// of the test lies where the drawing puts it.
 TEST(TtpTruth, TheWholeTestWithoutEffectsIsNominal) {
   const auto s = setup(true);
   SimulationOutputs out;
   auto truth = truthFrom("");
   const auto j = simulate(s, truth, &out);
-  EXPECT_GT(out.end_time_s, 8 * 3600);
+  const double wait = s.ttp().wait_s;
+  ASSERT_EQ(wait, kShortWait ? 600 : 3600);
+  EXPECT_GT(out.end_time_s, 8 * wait);
   ASSERT_EQ(j["ttp_cycles"].size(), 9u);
   for (const auto& c : j["ttp_cycles"]) {
     ASSERT_TRUE(c.contains("EX_um")) << c.dump();
@@ -296,19 +452,47 @@ TEST(TtpTruth, TheWholeTestWithoutEffectsIsNominal) {
     EXPECT_NEAR(c["d_X1_mm"].get<double>(), 97.5, 1e-9);
     EXPECT_NEAR(c["d_Z_mm"].get<double>(), 12.1, 1e-9);
   }
-  // The C load: 1200 rpm in the inputs while the table turns in the warm-up hours.
+  // The C load: 1200 rpm in the inputs (every 60 s) while the table turns in the four
+  // warm-up waits, all but the sample at a wait's edge.
   const CsvTable in = parseCsv(out.inputs_csv, "inputs");
   int turning = 0;
   for (const auto& row : in.rows) turning += in.number(row, in.column("c_rpm")) == 1200;
-  EXPECT_GE(turning, 4 * 59);
+  EXPECT_GE(turning, 4 * (static_cast<int>(wait / 60) - 1));
   // The top, sampled on a grid that crosses the engraved mark (0.2 mm deep) and the notches,
   // is the faced plane z 0.
   EXPECT_NEAR(feature(j, "TOP")["as_cut"]["point_mm"][2].get<double>(), 0, 1e-9);
 }
 
-// With the demo physics (examples/truth_thermal_test.yaml) and the cutting forces on: every
-// cycle is evaluated, the runs are byte-identical, and the printout is the 8 h series the
-// evaluation of the simulated CMM and on-machine data will be compared with.
+// With the demo physics (examples/truth_thermal_test.yaml: the C axis and the table warm
+// while C turns, the part follows the table through the adapter, the column grows with the
+// spindle) and the cutting forces on: the runs are byte-identical, and every cycle's
+// surfaces are where the machine's state at their cuts puts them. From the simulator's
+// definitions (docs/simulator.md §2.4), to first order in the location errors:
+// - a facet cut facing the machine direction u (X1 +X, Y1 +Y, X2 -X, Y2 -Y) with the tool
+//   centre at a + r from the axis: in the table's frame (R^T (q - t - pivot), the EB0C test)
+//   the tool's line lies at rho = (a + r - s) cos(psi) - H sin(psi) u_psi from the axis, with
+//   s = (table shift - tool shift) . u (EX0C, EY0C, tool_um), psi the tilt that turns u
+//   toward Z (EB0C for the X sides, EA0C for the Y sides), H sin(psi) u_psi its Abbe offset at
+//   the tip's height above the pivot at the table surface, H = 54.9 mm + tool_Z - EZ0T
+//   (+H sin(EB0C) along X, -H sin(EA0C) along Y, projected on u); then
+//   d = (rho - r) / k + delta_n - n . O with
+//   k = 1 + alpha T, T = part_above_20C_K (the part and the tool's radius in it scale by 1/k
+//   about the axis), delta_n the cut's deflection (cuts.json) along the facet's outward
+//   normal n (the tool pushed off the material leaves it proud), O the datum frame's origin.
+//   EC0C turns the line about the axis, which changes no distance. Neglected: the turn of
+//   the line by the product of the two tilts (1e-9 rad) and of the shifts' own turn by the
+//   tilts (EA0C x EX0C, 1e-10 mm);
+// - a Z path cut at y_j with C at 0 lies at z = z' / k - 67 in the part frame (the warm-part
+//   test), z' = H + (tool_Z - EZ0T) - y_j EA0C the tip's height above the table in the
+//   table's own frame, less |EB0C| x 4.4 mm where the tool's horizontal bottom meets the
+//   tilted path (the EB0C test). The depth is taken in the datum frame at (0, y_j): where
+//   the datum's Y axis (its z component y_z: the TOP plane rises by y_z per mm of y, faced
+//   pass by pass while the tool grew with the spindle's heat) reaches y_j, so
+//   E_Z = z_0 - z_i + y_z (y_i - y_0),
+//   within the staircase of a tilted floor (delta = 1e-5 mm, the EB0C test);
+// - E_B = -(EB0C_i - EB0C_0), within the staircase's slope error 1.5 delta / L per floor.
+// A part warmer at every facet cut than at the reference's makes the diameters smaller at
+// 20 C: E_TTP < 0 (the facets' deflections, 0.01-0.03 um, differ far less).
 TEST(TtpTruth, TheWholeTestWithTheDemoPhysics) {
   const auto s = setup(true, true);
   const auto truth = loadMachineTruth(src("examples/truth_thermal_test.yaml"));
@@ -323,13 +507,78 @@ TEST(TtpTruth, TheWholeTestWithTheDemoPhysics) {
                                      {"pre.ngc", s.pre}, {"test.ngc", s.test}})
       std::ofstream(std::string(dir) + "/" + name) << text;
   }
+  const auto cuts = nlohmann::json::parse(a.cuts_json);
+  const auto& t = s.ttp();
+  ASSERT_TRUE(truth.artifact.alpha_per_K);
+  const double alpha = *truth.artifact.alpha_per_K, A = t.facet_apothem_mm;
+  const double H = 40 + 3 + 24 - 12.1, delta = 1e-5;
+  ASSERT_NEAR(t.supportHeight() + t.finishedHeight() + t.cuttingZ(), H, 1e-12);
+  double half_u = 1e300;  // the shortest Z path (the outer ones)
+  for (const auto& f : s.piece.features)
+    if (f.role == "z_path") half_u = std::min(half_u, f.half_u_mm);
+  const double slope_bound = 1.5 * delta / (1.6 * half_u);
+  const double r = t.tool(t.test_tool)->diameter_mm / 2;
+  const double rows = floorRowsDepth(s);  // 4.4 mm, the EB0C test
+  ASSERT_TRUE(j["datum_frame"].contains("origin_mm"));
+  const Eigen::Vector2d O(j["datum_frame"]["origin_mm"][0].get<double>(), j["datum_frame"]["origin_mm"][1].get<double>());
+  const double y_z = j["datum_frame"]["y"][2].get<double>();
+  auto num = [](const nlohmann::json& m, const char* key) { return m[key].get<double>(); };
+
+  struct Sides {
+    FacetSide side;
+    const char* key;
+    Eigen::Vector2d u;
+  };
+  const Sides sides[] = {{FacetSide::X1, "d_X1_mm", {1, 0}},
+                         {FacetSide::X2, "d_X2_mm", {-1, 0}},
+                         {FacetSide::Y1, "d_Y1_mm", {0, 1}},
+                         {FacetSide::Y2, "d_Y2_mm", {0, -1}}};
   ASSERT_EQ(j["ttp_cycles"].size(), 9u);
+  double z0 = 0, eb0 = 0, y0 = 0, T0[4] = {0, 0, 0, 0};
+  int warmer_cycles = 0;
   for (const auto& c : j["ttp_cycles"]) {
     ASSERT_TRUE(c.contains("ETTP_um")) << c.dump();
-    std::printf("cycle %d t %7.0f s  EX %7.3f  EY %7.3f  EZ %7.3f  EB %7.3f  ETTP %7.3f um\n", c["cycle"].get<int>(),
-                c["time_s"].get<double>(), c["EX_um"].get<double>(), c["EY_um"].get<double>(), c["EZ_um"].get<double>(),
-                c["EB_urad"].get<double>(), c["ETTP_um"].get<double>());
+    const int cyc = c["cycle"].get<int>(), k = c["facet"].get<int>(), path = c["z_path"].get<int>();
+    bool warmer = cyc > 0;
+    for (int i = 0; i < 4; ++i) {
+      const auto& f = feature(j, parts::facetId(sides[i].side, k));
+      const auto& m = f["machine"];
+      const auto& cut = cuts.at(f["cut_index"].get<std::size_t>());
+      const Eigen::Vector2d shift(num(m, "EX0C_um") - m["tool_um"][0].get<double>(), num(m, "EY0C_um") - m["tool_um"][1].get<double>());
+      const double tilt_x = num(m, "EB0C_urad") * 1e-6, tilt_y = num(m, "EA0C_urad") * 1e-6;
+      const double psi = sides[i].u.x() != 0 ? tilt_x : tilt_y;
+      const double lever = H + (m["tool_um"][2].get<double>() - num(m, "EZ0T_um")) * 1e-3;  // the tip above the pivot
+      const Eigen::Vector2d abbe(lever * std::sin(tilt_x), -lever * std::sin(tilt_y));
+      const double rho = (A + r - shift.dot(sides[i].u) * 1e-3) * std::cos(psi) - abbe.dot(sides[i].u);
+      const double T = num(m, "part_above_20C_K");
+      const double phi = degToRad(parts::facetNormalAngle(t, sides[i].side, k));
+      const Eigen::Vector2d n(std::cos(phi), std::sin(phi));
+      const double defl_mm = (cut["deflection_um"][0].get<double>() * n.x() + cut["deflection_um"][1].get<double>() * n.y()) * 1e-3;
+      const double d = (rho - r) / (1 + alpha * T) + defl_mm - n.dot(O);
+      EXPECT_NEAR(c[sides[i].key].get<double>(), d, 1e-9) << "cycle " << cyc << " " << sides[i].key;
+      if (cyc == 0) T0[i] = T;
+      warmer = warmer && T > T0[i];
+    }
+    const auto& m = feature(j, parts::zPathId(path))["machine"];
+    const double y_j = parts::zPathY(t, path);
+    const double eb = num(m, "EB0C_urad");
+    const double z = (H + (m["tool_um"][2].get<double>() - num(m, "EZ0T_um")) * 1e-3 - y_j * num(m, "EA0C_urad") * 1e-6) /
+                         (1 + alpha * num(m, "part_above_20C_K")) -
+                     std::fabs(eb) * 1e-6 * rows;
+    if (cyc == 0) z0 = z, eb0 = eb, y0 = y_j;
+    EXPECT_NEAR(c["EZ_um"].get<double>(), (z0 - z + y_z * (y_j - y0)) * 1e3, delta * 1e3) << "cycle " << cyc;
+    EXPECT_NEAR(c["EB_urad"].get<double>(), -(eb - eb0), 2 * slope_bound * 1e6) << "cycle " << cyc;
+    if (warmer) {
+      ++warmer_cycles;
+      EXPECT_LT(c["ETTP_um"].get<double>(), 0) << "cycle " << cyc;
+    }
+    std::printf("cycle %d t %7.0f s  EX %7.3f  EY %7.3f  EZ %7.3f  EB %7.3f  ETTP %7.3f um\n", cyc, c["time_s"].get<double>(),
+                c["EX_um"].get<double>(), c["EY_um"].get<double>(), c["EZ_um"].get<double>(), c["EB_urad"].get<double>(),
+                c["ETTP_um"].get<double>());
   }
+  // The table heats the part through the adapter from the first load on, and it has not
+  // cooled back to the reference's temperature by the end of the hold.
+  EXPECT_EQ(warmer_cycles, 8);
 }
 
 }  // namespace

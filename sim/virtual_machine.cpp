@@ -647,12 +647,10 @@ class VirtualMachine : public gcode::MachineInterface {
     Artifact art;
     art.dT = nodeRise(tr_.artifact.node);
     const double grow = 1.0 + partAlpha() * art.dT;
-    const double sense = m_.c.positive_is_clockwise ? -1.0 : 1.0;
-    const double th = degToRad(a_->angle_at_c0_deg + sense * pos_.c_deg);
-    const double rot = degToRad(sense * pos_.c_deg);
+    const double th = degToRad(a_->angle_at_c0_deg + cSense() * pos_.c_deg);
     const Vector3d& pe = tr_.artifact.placement_error_mm;
-    const Vector3d placement(std::cos(rot) * pe.x() - std::sin(rot) * pe.y(),
-                             std::sin(rot) * pe.x() + std::cos(rot) * pe.y(), pe.z());
+    const Eigen::Vector2d pe_turned = parts::turnedByTable(pe.head<2>(), pos_.c_deg, m_.c.positive_is_clockwise);
+    const Vector3d placement(pe_turned.x(), pe_turned.y(), pe.z());
     const Vector3d nominal(m_.c_axis_centre_mm.x() + a_->radius_from_axis_mm * grow * std::cos(th),
                            m_.c_axis_centre_mm.y() + a_->radius_from_axis_mm * grow * std::sin(th),
                            m_.table_surface_z_mm + a_->centreHeightAboveTable() * grow);
@@ -773,12 +771,8 @@ class VirtualMachine : public gcode::MachineInterface {
 
   // --- the workpiece --------------------------------------------------------------------
   // Machine coordinates of a point (tip coordinates) -> the part frame at 20 °C: undo the
-  // table's location errors (a rigid motion), turn back to C = 0, less the placement error,
-  // less the part frame's origin (machine coordinates at C = 0), undo the part's expansion
-  // about its datum (the blank's bottom centre).
-  Vector3d toWorkpiece(const Vector3d& q) const { return toWorkpieceAt(q, pos_.c_deg); }
-  // The same with the table at another C (the tool's place in the part while C turns).
-  Vector3d toWorkpieceAt(const Vector3d& q, double c_deg) const {
+  // table's location errors (a rigid motion), turn back to C = 0, then tableToPart.
+  Vector3d toWorkpiece(const Vector3d& q) const {
     // The table's location errors as a rigid motion about the C axis at the table surface
     // (a clamped workpiece moves with the table as one body; ER0T, a radial growth of the
     // table, does not move it).
@@ -789,25 +783,29 @@ class VirtualMachine : public gcode::MachineInterface {
                                Eigen::AngleAxisd(-e[6] * 1e-6, Vector3d::UnitZ())).toRotationMatrix();
     const Vector3d t(e[0] * 1e-3, e[1] * 1e-3, e[2] * 1e-3);
     Vector3d p = pivot + R.transpose() * (q - t - pivot);
-    const double sense = m_.c.positive_is_clockwise ? -1.0 : 1.0;
-    const double a = -degToRad(sense * c_deg);
-    const Eigen::Vector2d c = m_.c_axis_centre_mm, d = p.head<2>() - c;
-    p.head<2>() = c + Eigen::Vector2d(std::cos(a) * d.x() - std::sin(a) * d.y(), std::sin(a) * d.x() + std::cos(a) * d.y());
+    const Eigen::Vector2d c = m_.c_axis_centre_mm;
+    p.head<2>() = c + parts::unturnedByTable(p.head<2>() - c, pos_.c_deg, m_.c.positive_is_clockwise);
+    return tableToPart(p);
+  }
+  // A point on the table at C = 0 (machine coordinates, the table's errors undone) -> the
+  // part frame at 20 °C: less `artifact.placement_error`, less the part frame's origin
+  // (machine coordinates at C = 0), less the lift of a warm support (adapter and washers of
+  // the part's alloy at its temperature: alpha dT support_height; kind: workpiece has none),
+  // and the part's own expansion about its datum (the blank's bottom centre) undone.
+  Vector3d tableToPart(Vector3d p) const {
+    const double e = partAlpha() * workpieceAbove20K();
     p -= tr_.artifact.placement_error_mm;  // where the part really sits on the table
     p -= w_->frame_origin_mm;              // machine at C = 0 -> part frame
-    return w_->datum() + (p - w_->datum()) / (1.0 + partAlpha() * workpieceAbove20K());
+    if (w_->support_height_mm != 0) p.z() -= e * w_->support_height_mm;
+    return w_->datum() + (p - w_->datum()) / (1.0 + e);
   }
-  // Where the C axis is in the part frame (at 20 °C): the image of the axis under the same
-  // steps (placement, frame origin, expansion about the datum); the tool circles about it
-  // when C turns. For the thermal test piece it is the origin.
+  // Where the C axis is in the part frame (at 20 °C); the tool circles about it when C
+  // turns. For the thermal test piece it is the origin.
   Eigen::Vector2d cAxisInPart() const {
-    Vector3d p(m_.c_axis_centre_mm.x(), m_.c_axis_centre_mm.y(), 0);
-    p -= tr_.artifact.placement_error_mm;
-    p -= w_->frame_origin_mm;
-    return (w_->datum() + (p - w_->datum()) / (1.0 + partAlpha() * workpieceAbove20K())).head<2>();
+    return tableToPart(Vector3d(m_.c_axis_centre_mm.x(), m_.c_axis_centre_mm.y(), 0)).head<2>();
   }
   // A part angle th appears in the machine at th + s C: s = -1 when +C turns the table clockwise.
-  double cSense() const { return m_.c.positive_is_clockwise ? -1.0 : 1.0; }
+  double cSense() const { return parts::tableTurnSign(m_.c.positive_is_clockwise); }
   // The part's expansion coefficient: the truth's when it states one, else the material's.
   double partAlpha() const {
     if (tr_.artifact.alpha_per_K) return *tr_.artifact.alpha_per_K;
@@ -819,9 +817,8 @@ class VirtualMachine : public gcode::MachineInterface {
   }
   // A direction in the workpiece frame -> machine frame (rotation by C only).
   Vector3d workpieceDirToMachine(const Vector3d& v) const {
-    const double sense = m_.c.positive_is_clockwise ? -1.0 : 1.0;
-    const double a = degToRad(sense * pos_.c_deg);
-    return Vector3d(std::cos(a) * v.x() - std::sin(a) * v.y(), std::sin(a) * v.x() + std::cos(a) * v.y(), v.z());
+    const Eigen::Vector2d m = parts::turnedByTable(v.head<2>(), pos_.c_deg, m_.c.positive_is_clockwise);
+    return Vector3d(m.x(), m.y(), v.z());
   }
 
   // Does the tool at gauge position g sit in material (height field)? For a flat end mill
@@ -900,24 +897,29 @@ class VirtualMachine : public gcode::MachineInterface {
                           "material (tool edge " + formatNumber(rho - r, 3) + " mm from the C axis; material up to " +
                           formatNumber(material, 3) + " mm, plus " + formatNumber(kTurnClearance_mm) + " mm clearance)");
     }
-    double lo = 0, span = 0;
-    turnArc(w, axis, to.c_deg - pos_.c_deg, lo, span);
-    checkObstaclesArc(axis, rho, lo, span, w.z(), what);
+    const TurnArc arc = turnArc(w, axis, to.c_deg - pos_.c_deg);
+    checkObstaclesArc(axis, rho, arc.ccw.lo, arc.ccw.span, w.z(), what);
   }
   static constexpr double kTurnClearance_mm = 0.5;
 
   // The arc a still tool at part position w describes when C changes by dc_deg: it starts at
-  // its angle about the axis and sweeps -s dC (counterclockwise positive), normalised here to
-  // a counterclockwise [lo, lo + span] of at most one turn.
-  void turnArc(const Vector3d& w, const Eigen::Vector2d& axis, double dc_deg, double& lo, double& span) const {
-    const double start = std::atan2(w.y() - axis.y(), w.x() - axis.x());
-    const double sweep = -cSense() * degToRad(dc_deg);
-    span = std::min(std::fabs(sweep), 2 * kPi);
-    lo = sweep >= 0 ? start : start - span;
+  // its angle about the axis and sweeps -s dC (counterclockwise positive); `ccw` is the same
+  // as a counterclockwise [lo, lo + span] of at most one turn.
+  struct TurnArc {
+    double start = 0, sweep = 0;
+    CcwArc ccw;
+  };
+  TurnArc turnArc(const Vector3d& w, const Eigen::Vector2d& axis, double dc_deg) const {
+    TurnArc a;
+    a.start = std::atan2(w.y() - axis.y(), w.x() - axis.x());
+    a.sweep = -cSense() * degToRad(dc_deg);
+    a.ccw = ccwArc(a.start, a.sweep);
+    return a;
   }
 
   void checkWorkpiecePath(const MachinePosition& to, const std::string& what) const {
     const Vector3d a = pos_.xyz_mm, b = to.xyz_mm;
+    if (to.c_deg != pos_.c_deg && a != b) checkTogetherWithC(to, what);
     const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / 0.5)));
     for (int k = 0; k <= n; ++k) {
       const Vector3d g = a + (b - a) * (static_cast<double>(k) / n);
@@ -932,6 +934,22 @@ class VirtualMachine : public gcode::MachineInterface {
     }
     if (!w_->obstacles.empty() && a != b) checkObstacles(toWorkpiece(tipActual(a)), toWorkpiece(tipActual(b)), what);
     if (to.c_deg != pos_.c_deg) checkTurn(to, what);
+  }
+
+  // X/Y/Z moving together with C: in the part frame the tool follows a curve (the line
+  // turned by the changing C), which the path checks (the straight line at the start's C,
+  // then the turn at the start's X/Y/Z) do not follow. Above the top of the part and of every
+  // obstacle nothing can be met, so it is allowed there; below it, refused as not modelled
+  // (the planner never moves them together: it turns C alone, or above the part).
+  void checkTogetherWithC(const MachinePosition& to, const std::string& what) const {
+    double top = stock_.max().z();
+    for (const auto& o : w_->obstacles) top = std::max(top, o.z_max_mm);
+    const double bottom = std::min(toWorkpiece(tipActual(pos_.xyz_mm)).z(), toWorkpiece(tipActual(to.xyz_mm)).z()) -
+                          bottomBelowTip();
+    if (bottom < top + 1e-9)
+      throw SafetyError(what + " moves X/Y/Z and C together below the top of the part: not modelled (the tool's bottom "
+                        "reaches Z " + formatNumber(bottom, 3) + ", the part and its obstacles Z " + formatNumber(top, 3) +
+                        ", part frame); turn C alone, or move above the top");
   }
 
   // Seed 000 Eq. 3.16 with I1 = I2 = I (the printed E*I^2 is read as E*I, notes §4.8):
@@ -958,7 +976,7 @@ class VirtualMachine : public gcode::MachineInterface {
     s.tool = tool_;
     s.location = locationErrors();
     s.tool_um = toolDriftUm();
-    s.part_dT_K = nodeRise(tr_.artifact.node);
+    s.part_above_20C_K = workpieceAbove20K();
     cut_states_.push_back(s);
   }
 
@@ -979,7 +997,9 @@ class VirtualMachine : public gcode::MachineInterface {
     checkObstacles(w0, w1, "feed move (G1/G2/G3)");
     const double len = (to.xyz_mm - pos_.xyz_mm).norm();
     const double dt = len / F * 60.0;
-    const Removal rem = stock_.removeHeightField(w0, w1, r);
+    // A chord of a ring around the part cannot reach the blank: nothing to remove (the hot
+    // path of the test's moves around the part).
+    const Removal rem = stock_.segmentReachesBlank(w0, w1, r) ? stock_.removeHeightField(w0, w1, r) : Removal{};
     Vector3d defl = Vector3d::Zero();
     double Ft = 0, Fn = 0;
     if (rem.volume_mm3 > 0 && dt > 0) {
@@ -1046,11 +1066,9 @@ class VirtualMachine : public gcode::MachineInterface {
     const Eigen::Vector2d axis = cAxisInPart();
     const double rho = (w0.head<2>() - axis).norm();
     const double dc = to.c_deg - pos_.c_deg;
-    const double start = std::atan2(w0.y() - axis.y(), w0.x() - axis.x());
-    const double sweep = -cSense() * degToRad(dc);
-    double lo = 0, span = 0;
-    turnArc(w0, axis, dc, lo, span);
-    checkObstaclesArc(axis, rho, lo, span, w0.z(), "feed move (G1)");
+    const TurnArc arc = turnArc(w0, axis, dc);
+    const double start = arc.start, sweep = arc.sweep;
+    checkObstaclesArc(axis, rho, arc.ccw.lo, arc.ccw.span, w0.z(), "feed move (G1)");
     const double dt = std::fabs(dc) / F_deg_per_min * 60.0;
     const double turns = std::fabs(sweep) / (2 * kPi);
     const double cut_sweep = std::clamp(sweep, -2 * kPi, 2 * kPi);
@@ -1258,8 +1276,7 @@ SimulationOutputs simulatePrograms(const std::vector<ProgramSource>& programs, c
   if (part.workpiece) {
     out.cuts_json = vm.cutsJson();
     if (!part.cmm_points.empty())
-      out.cmm_csv = measureOnCmm(vm.stock(), *part.workpiece, part.cmm_points, part.cmm_points_file, seed, 5.0,
-                                 vm.partAlphaPerK());
+      out.cmm_csv = measureOnCmm(vm.stock(), *part.workpiece, part.cmm_points, part.cmm_points_file, seed, vm.partAlphaPerK());
   }
 
   out.inputs_csv = vm.inputsText();

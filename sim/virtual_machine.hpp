@@ -20,7 +20,9 @@
 //   part frame, whose origin is `frame_origin_mm` in machine tip coordinates at C = 0; cuts
 //   with flat end mills (linear, or by turning C alone) remove material exactly
 //   (sim/material_removal.hpp); obstacles may not be touched; the table may turn with the
-//   tool below the top of the stock only while the tool is clear of its material (0.5 mm);
+//   tool below the top of the stock only while the tool is clear of its material (0.5 mm),
+//   and X/Y/Z may move together with C only above the top (below it: not modelled); a warm
+//   support (`support_height`, the part's alloy) lifts the part by alpha dT support_height;
 // - a feed move of C alone reads F in deg/min and is limited by the axis's turning speed;
 //   C's real speed in such moves heats the C-axis node and is inputs.csv's c_rpm (rapid
 //   indexing is not counted: < 1 s per quarter turn, and the sphere campaigns' outputs stay

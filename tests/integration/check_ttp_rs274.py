@@ -11,7 +11,8 @@ Checks:
     as a STRAIGHT_FEED ending at the planned point and C, in the planned order (a cut whose
     from = to is a turn of C: a STRAIGHT_FEED at that point turning C by one full turn);
   test: Z is constant (1e-4 mm) on every motion from the first cutting feed to the last, and
-    equals the cuts' Z;
+    equals the cuts' Z; the feeds of C alone (the load) come in pairs that leave C where it was
+    (incremental +N and -N turns, docs/thermal-test-piece.md §5);
   inspection: every STRAIGHT_PROBE is either a measuring move (a LOG follows) whose target is
     the planned overtravel end on the approach line (contact + overtravel * approach) at the
     planned C, or a protected move that ends at the next measuring move's start (contact -
@@ -19,8 +20,8 @@ Checks:
     manifest's order with cycle 1 and the right position/point.
 
 The probing distances are not in the manifest: give them (the description's
-inspection.probing.overtravel / approach) or they are read off the first point and every other
-point must agree.
+inspection.probing.overtravel / approach, e.g. --overtravel 2 --approach 3) or they are read off
+the first point and every other point must agree.
 
 Usage: check_ttp_rs274.py plan.json CANON CANON CANON [--overtravel MM] [--approach MM]
   (the canonical outputs of the manifest's programs, in its order: pre-machining, test, inspection)
@@ -30,12 +31,16 @@ import json
 import re
 import sys
 
-ap = argparse.ArgumentParser(usage=__doc__)
-ap.add_argument("plan")
-ap.add_argument("canons", nargs=3)
-ap.add_argument("--overtravel", type=float)
-ap.add_argument("--approach", type=float)
+ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+ap.add_argument("plan", help="plan.json of the thermal test piece")
+ap.add_argument("canons", nargs=3, metavar="CANON", help="rs274 output of pre-machining, test, inspection")
+ap.add_argument("--overtravel", type=float, metavar="MM", help="inspection.probing.overtravel of the description")
+ap.add_argument("--approach", type=float, metavar="MM", help="inspection.probing.approach of the description")
 args = ap.parse_args()
+for name in ("overtravel", "approach"):
+    v = getattr(args, name)
+    if v is not None and not v > 0:
+        ap.error(f"--{name} must be a positive distance in mm (got {v})")
 plan = json.load(open(args.plan))
 roles = [p.get("role") for p in plan["programs"]]
 if roles != ["pre_machining", "test", "inspection"]:
@@ -133,6 +138,16 @@ else:
     for c in plan["cuts"]:
         if c["program"] == "test" and (abs(c["from_mm"][2] - z_value) > TOL or abs(c["to_mm"][2] - z_value) > TOL):
             errors.append(f"test: cut {c['id']} is planned at Z {c['to_mm'][2]}, the program cuts at Z {z_value}")
+# The load: feeds of C alone (X, Y, Z where the motion before left them), forward then back.
+c_feeds = [(motions[i - 1][1][5], v[5]) for i, (k, v) in enumerate(motions)
+           if i > 0 and k == "STRAIGHT_FEED" and close(v[:3], motions[i - 1][1][:3]) and abs(v[5] - motions[i - 1][1][5]) > CTOL]
+if len(c_feeds) % 2:
+    errors.append(f"test: {len(c_feeds)} feeds of C alone, not pairs of forward and back")
+for n in range(0, len(c_feeds) - 1, 2):
+    (a0, a1), (b0, b1) = c_feeds[n], c_feeds[n + 1]
+    if abs(a1 - a0) < 360 - CTOL or abs(b1 - a0) > CTOL or abs(b0 - a1) > CTOL:
+        errors.append(f"test: C load pair {n // 2 + 1}: C {a0} -> {a1} -> {b1}, expected whole turns forward and back to {a0}")
+        break
 
 insp = events(insp_file, "inspection")
 points = plan["points"]
@@ -198,5 +213,5 @@ if errors:
     sys.exit(1)
 n_pre = len([c for c in plan["cuts"] if c["program"] == "pre_machining"])
 print(f"rs274 check ok: pre-machining {n_pre} finishing cuts in order; test {n_test_cuts} cuts in order at constant "
-      f"Z {z_value:.4f}; inspection {measuring} measuring + {protected} protected probe moves (approach {approach_mm} mm, "
+      f"Z {z_value:.4f}, {len(c_feeds) // 2} C load pairs back to their start; inspection {measuring} measuring + {protected} protected probe moves (approach {approach_mm} mm, "
       f"overtravel {overtravel} mm), {len(logs)} LOG lines, no ABORT")
