@@ -121,7 +121,7 @@ for route, src in (("cmm", f"{W}/run/cmm_export.csv"), ("om", f"{W}/run/dprnt.tx
 
 # U for k = 2 covers about 95 % of the values one at a time; every cycle shares the
 # reference cut's measurement, so the 40 values of one run move together and "all within U"
-# is not what a calibrated U promises (over 12 seeds 455 of 480 CMM values, 94.8 %, lay
+# is not what a calibrated U promises (over 12 seeds 454 of 480 CMM values, 94.6 %, lay
 # within U). One run: none beyond 2 U, the count printed; several seeds pooled (below): the
 # coverage and the spread of z = d / u say whether U is honest.
 for route, series in routes.items():
