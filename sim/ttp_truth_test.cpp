@@ -15,6 +15,7 @@
 #include <iterator>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <stdexcept>
 
 #include "core/csv.hpp"
 #include "core/units.hpp"
@@ -212,6 +213,20 @@ Gap gap(const nlohmann::json& truth) {
   return {last0, first1};
 }
 
+// 10 min into the wait between the reference cycle and cycle 1, from a run without errors:
+// a step there reaches every cut of cycle 1 and none of the reference.
+double betweenTheCycles_s(const Setup& s) {
+  const Gap g = gap(simulate(s, truthFrom("")));
+  const double t = g.from_s + 600;
+  if (!(t + 1 < g.to_s)) throw std::logic_error("the wait between the reference and cycle 1 is under 10 min");
+  return t;
+}
+
+// A location error stepping from 0 to `error` (e.g. "EX0C_um: 4") within 1 s at t.
+std::string locationStep(double t, const std::string& error) {
+  return "location_keyframes: [{time: " + formatNumber(t) + " s}, {time: " + formatNumber(t + 1) + " s, " + error + "}]\n";
+}
+
 // How much deeper than a ramp tilted by theta along its path a flat end mill that stays
 // horizontal in the part frame leaves the floor, per unit theta, as the truth's plane fit
 // sees it (the EB0C test): the mean of sqrt(r^2 - y^2) over its sample rows, y = 0 and
@@ -260,11 +275,7 @@ TEST(TtpTruth, WithoutEffectsEveryErrorIsZero) {
 // only moves along themselves. E_X = (dd_X2 - dd_X1) / 2 = +e; E_Y, E_Z, E_B, E_TTP stay 0.
 TEST(TtpTruth, ATableShiftInXIsEX) {
   const auto s = setup();
-  const Gap g = gap(simulate(s, truthFrom("")));
-  const double t = g.from_s + 600;
-  ASSERT_LT(t + 1, g.to_s);
-  const auto j = simulate(s, truthFrom("location_keyframes: [{time: " + formatNumber(t) + " s}, {time: " + formatNumber(t + 1) +
-                                       " s, EX0C_um: 4}]\n"));
+  const auto j = simulate(s, truthFrom(locationStep(betweenTheCycles_s(s), "EX0C_um: 4")));
   const auto& c1 = j["ttp_cycles"][1];
   EXPECT_NEAR(c1["EX_um"].get<double>(), 4, kUm);
   for (const char* e : {"EY_um", "EZ_um", "EB_urad", "ETTP_um", "ETTP_7_9_um"}) EXPECT_NEAR(c1[e].get<double>(), 0, kUm) << e;
@@ -282,11 +293,7 @@ TEST(TtpTruth, ATableShiftInXIsEX) {
 // sign corrected); E_X, E_Z, E_B, E_TTP stay 0.
 TEST(TtpTruth, ATableShiftInYIsEY) {
   const auto s = setup();
-  const Gap g = gap(simulate(s, truthFrom("")));
-  const double t = g.from_s + 600;
-  ASSERT_LT(t + 1, g.to_s);
-  const auto j = simulate(s, truthFrom("location_keyframes: [{time: " + formatNumber(t) + " s}, {time: " + formatNumber(t + 1) +
-                                       " s, EY0C_um: 4}]\n"));
+  const auto j = simulate(s, truthFrom(locationStep(betweenTheCycles_s(s), "EY0C_um: 4")));
   const auto& c1 = j["ttp_cycles"][1];
   EXPECT_NEAR(c1["EY_um"].get<double>(), 4, kUm);
   for (const char* e : {"EX_um", "EZ_um", "EB_urad", "ETTP_um", "ETTP_7_9_um"}) EXPECT_NEAR(c1[e].get<double>(), 0, kUm) << e;
@@ -322,12 +329,8 @@ TEST(TtpTruth, ATableShiftInYIsEY) {
 // their upper Z).
 TEST(TtpTruth, ATableTiltAboutYIsMinusEB) {
   const auto s = setup();
-  const Gap g = gap(simulate(s, truthFrom("")));
-  const double t = g.from_s + 600;
-  ASSERT_LT(t + 1, g.to_s);
   const double theta = 20e-6;
-  const auto j = simulate(s, truthFrom("location_keyframes: [{time: " + formatNumber(t) + " s}, {time: " + formatNumber(t + 1) +
-                                       " s, EB0C_urad: 20}]\n"));
+  const auto j = simulate(s, truthFrom(locationStep(betweenTheCycles_s(s), "EB0C_urad: 20")));
   const double H = 40 + 3 + 24 - 12.1, a = 97.5, r = 6, delta = 1e-5;
   ASSERT_NEAR(s.ttp().supportHeight() + s.ttp().finishedHeight() + s.ttp().cuttingZ(), H, 1e-12);
   double half_u = 0;  // Z1's half length: the samples span 80 % of it each way
@@ -350,8 +353,7 @@ TEST(TtpTruth, ATableTiltAboutYIsMinusEB) {
 // d_Z(t0) = -5 um; the facets, cut by the tool's flank, do not move.
 TEST(TtpTruth, ToolGrowthIsMinusEZ) {
   const auto s = setup();
-  const Gap g = gap(simulate(s, truthFrom("")));
-  const double t = g.from_s + 600;
+  const double t = betweenTheCycles_s(s);
   const auto j = simulate(s, truthFrom(R"(
 thermal:
   environment: {mean_C: 20, events: [{at: )" + formatNumber(t) + R"( s, change_K: 1, ramp: 1 s}]}
@@ -379,8 +381,7 @@ thermal:
 // gives for E_Z).
 TEST(TtpTruth, AWarmPartIsMinusTwoAlphaDTa) {
   const auto s = setup();
-  const Gap g = gap(simulate(s, truthFrom("")));
-  const double t = g.from_s + 600;
+  const double t = betweenTheCycles_s(s);
   const auto j = simulate(s, truthFrom(R"(
 thermal:
   environment: {mean_C: 20, events: [{at: )" + formatNumber(t) + R"( s, change_K: 5, ramp: 1 s}]}
