@@ -40,6 +40,20 @@ TestPiece fromThermalTestPiece(ThermalTestPiece p) {
   return t;
 }
 
+// The stepped workpiece's features are the standard step sizes; an experiment cut to the
+// alternative set (W2, W5) gets its own from nominalFeatures(w, w.sizesFor(e)). Its planner,
+// simulation and evaluation are the rest of issue 14.
+TestPiece fromSteppedWorkpiece(SteppedWorkpiece w) {
+  TestPiece t;
+  t.kind = "stepped_workpiece";
+  t.file = w.file;
+  t.name = w.name;
+  t.features = nominalFeatures(w);
+  t.stock = steppedWorkpieceStock(w);
+  t.description = std::move(w);
+  return t;
+}
+
 TestPiece fromWorkpiece(Workpiece w) {
   TestPiece t;
   t.kind = "workpiece";
@@ -53,7 +67,7 @@ TestPiece fromWorkpiece(Workpiece w) {
 }  // namespace
 
 const std::vector<std::string>& testPieceKinds() {
-  static const std::vector<std::string> kinds{"sphere_artifact", "thermal_test_piece", "workpiece"};
+  static const std::vector<std::string> kinds{"sphere_artifact", "thermal_test_piece", "stepped_workpiece", "workpiece"};
   return kinds;
 }
 
@@ -61,6 +75,7 @@ TestPiece loadTestPiece(const std::string& path) {
   const std::string kind = partKind(path);
   if (kind == "sphere_artifact") return fromSphereArtifact(loadSphereArtifact(path));
   if (kind == "thermal_test_piece") return fromThermalTestPiece(loadThermalTestPiece(path));
+  if (kind == "stepped_workpiece") return fromSteppedWorkpiece(loadSteppedWorkpiece(path));
   if (kind == "workpiece") return fromWorkpiece(loadWorkpiece(path));
   std::string list;
   for (const auto& k : testPieceKinds()) list += (list.empty() ? "" : ", ") + k;

@@ -22,6 +22,7 @@
 #include "model/effects.hpp"
 #include "parts/feature.hpp"
 #include "parts/sphere_artifact.hpp"
+#include "parts/stepped_workpiece.hpp"
 #include "parts/thermal_test_piece.hpp"
 #include "parts/workpiece.hpp"
 
@@ -29,13 +30,14 @@ namespace probeloop::parts {
 
 struct TestPiece {
   std::string kind, file, name;
-  std::variant<SphereArtifact, ThermalTestPiece, Workpiece> description;
+  std::variant<SphereArtifact, ThermalTestPiece, SteppedWorkpiece, Workpiece> description;
   std::vector<NominalFeature> features;
   std::optional<Workpiece> stock;
   std::vector<EvaluationRule> evaluation;
 
   const SphereArtifact* sphereArtifact() const { return std::get_if<SphereArtifact>(&description); }
   const ThermalTestPiece* thermalTestPiece() const { return std::get_if<ThermalTestPiece>(&description); }
+  const SteppedWorkpiece* steppedWorkpiece() const { return std::get_if<SteppedWorkpiece>(&description); }
 };
 
 TestPiece loadTestPiece(const std::string& path);

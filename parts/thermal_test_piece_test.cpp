@@ -252,7 +252,7 @@ TEST(TestPieces, EveryKindLoadsIntoOneModel) {
     loadTestPiece(p.string());
     FAIL() << "accepted an unknown kind";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("sphere_artifact, thermal_test_piece, workpiece"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("sphere_artifact, thermal_test_piece, stepped_workpiece, workpiece"), std::string::npos) << e.what();
   }
 }
 

@@ -157,6 +157,10 @@ TestPiecePlan planTestPiece(const parts::TestPiece& piece, const parts::Machine&
                             const std::string& out_dir) {
   if (const auto* a = piece.sphereArtifact()) return sphere(*a, machine, dialect, out_dir);
   if (const auto* t = piece.thermalTestPiece()) return thermal(piece, *t, machine, dialect, out_dir);
+  if (piece.steppedWorkpiece())
+    throw InputError(piece.file, 0,
+                     "kind: stepped_workpiece has no planner yet (issue 14: the W1-W8 programs come next); its description, "
+                     "features and stock load and are checked");
   if (piece.kind == "workpiece")
     throw InputError(piece.file, 0,
                      "a plain workpiece has no planner: write its program yourself and run it with probeloop simulate");

@@ -3,6 +3,8 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include "core/error.hpp"
 #include "planner/sphere_cycle.hpp"
 
@@ -51,6 +53,21 @@ TEST(PlanTestPiece, APlainWorkpieceHasNoPlanner) {
               std::string::npos)
         << e.what();
   }
+}
+
+// Issue 14 in progress: the description loads, planning says what is missing, nothing written.
+TEST(PlanTestPiece, TheSteppedWorkpieceHasNoPlannerYet) {
+  const auto piece = parts::loadTestPiece(src + "/parts/stepped_workpiece.yaml");
+  const auto out = std::filesystem::temp_directory_path() / "probeloop-sw-plan-never-written";
+  std::filesystem::remove_all(out);
+  try {
+    planTestPiece(piece, machine("vmc3"), parts::Dialect::LinuxCnc, out.string());
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("stepped_workpiece.yaml: kind: stepped_workpiece has no planner yet"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 TEST(PlanTestPiece, TheThermalTestPieceGivesThreeProgramsTheCmmPlanAndASummary) {

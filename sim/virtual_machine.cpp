@@ -1197,6 +1197,10 @@ parts::Workpiece placeOnMachine(const parts::TestPiece& piece, const parts::Mach
     w.frame_origin_mm = parts::partOriginOnMachine(*t, machine.c_axis_centre_mm, machine.table_surface_z_mm);
     return w;
   }
+  if (piece.steppedWorkpiece())
+    throw InputError(piece.file, 0,
+                     "kind: stepped_workpiece cannot be placed on the virtual machine yet (issue 14: its fixture on the "
+                     "table, then the W1-W8 programs)");
   if (!piece.stock)
     throw InputError(piece.file, 0, "kind: " + piece.kind + " is not machined: it stands on the table as it is, not as a workpiece");
   return *piece.stock;

@@ -1,0 +1,266 @@
+#include "parts/stepped_workpiece.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/csv.hpp"
+#include "core/error.hpp"
+#include "parts/yaml_reader.hpp"
+
+namespace probeloop::parts {
+
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+const SwExperiment* SteppedWorkpiece::experiment(const std::string& id) const {
+  for (const auto& e : experiments)
+    if (e.id == id) return &e;
+  return nullptr;
+}
+
+std::vector<double> SteppedWorkpiece::sizesFor(const SwExperiment& e) const {
+  if (e.alternative_sizes) return alternative_sizes_mm;
+  std::vector<double> out;
+  for (const auto& s : steps) out.push_back(s.size_mm);
+  return out;
+}
+
+namespace {
+
+double positive(YamlMap& m, const std::string& key, Dimension dim) {
+  const double v = m.quantity(key, dim);
+  if (!(v > 0)) m.fail(key, "must be positive");
+  return v;
+}
+
+// Sizes that grow from the top step down and leave a wall on every side of the next step
+// (a step no larger than the one above it would have no floor to probe).
+void checkSizes(YamlMap& m, const std::string& key, const std::vector<double>& sizes, double blank_x, double blank_y,
+                double tool_diameter) {
+  for (std::size_t k = 0; k < sizes.size(); ++k) {
+    if (!(sizes[k] > 0)) m.fail(key, "step " + std::to_string(k + 1) + ": the size must be positive");
+    if (k > 0 && !(sizes[k] > sizes[k - 1]))
+      m.fail(key, "step " + std::to_string(k + 1) + " (" + formatNumber(sizes[k]) + " mm) must be larger than step " +
+                      std::to_string(k) + " (" + formatNumber(sizes[k - 1]) + " mm): the steps grow from the top down");
+  }
+  // The blank is centred on the steps; the last step needs room for the tool around it.
+  const double room = std::min(blank_x, blank_y) - sizes.back();
+  if (!(room >= 2 * tool_diameter))
+    m.fail(key, "the largest step (" + formatNumber(sizes.back()) + " mm) leaves " + formatNumber(room / 2) +
+                    " mm to the blank's edge: the finishing tool (diameter " + formatNumber(tool_diameter) +
+                    " mm) needs at least its diameter on each side");
+}
+
+SwExperiment readExperiment(YamlMap e, std::size_t n_steps) {
+  SwExperiment x;
+  x.id = e.string("id");
+  x.purpose = e.stringOr("purpose", "");
+  x.transition = e.choice("transition", {"non_cutting", "fast", "continuous"});
+  if (x.transition == "continuous") {
+    if (e.has("transition_feed")) e.fail("transition_feed", "a continuous path has no transitions: leave it out");
+  } else {
+    x.transition_feed_mm_per_min = positive(e, "transition_feed", Dimension::Feed);
+  }
+  x.tool_runout_mm = e.quantity("tool_runout", Dimension::Length);
+  if (!(x.tool_runout_mm >= 0 && x.tool_runout_mm < 0.1)) e.fail("tool_runout", "expected 0 to 0.1 mm (Table 4.1: 0.004)");
+  x.alternative_sizes = e.booleanOr("alternative_sizes", false);
+  auto list = e.mapList("steps");
+  if (list.size() != n_steps)
+    e.fail("steps", "expected " + std::to_string(n_steps) + " entries, one per step of the workpiece, got " +
+                        std::to_string(list.size()));
+  for (auto& s : list) {
+    SwCutConditions c;
+    c.feed_xy_mm_per_min = positive(s, "feed_xy", Dimension::Feed);
+    c.feed_z_mm_per_min = positive(s, "feed_z", Dimension::Feed);
+    c.spindle_speed_rpm = positive(s, "spindle_speed", Dimension::RotSpeed);
+    s.finish();
+    x.steps.push_back(c);
+  }
+  e.finish();
+  return x;
+}
+
+}  // namespace
+
+SteppedWorkpiece loadSteppedWorkpiece(const std::string& path) {
+  YamlMap root(loadYamlFile(path), path, "");
+  root.choice("kind", {"stepped_workpiece"});
+  SteppedWorkpiece w;
+  w.file = path;
+  w.name = root.stringOr("name", "stepped workpiece");
+
+  YamlMap b = root.map("blank");
+  {
+    const auto size = b.quantityList("size", Dimension::Length);
+    if (size.size() != 2 || !(size[0] > 0 && size[1] > 0)) b.fail("size", "expected [x, y], both positive");
+    w.blank_x_mm = size[0];
+    w.blank_y_mm = size[1];
+  }
+  w.blank_height_mm = positive(b, "height", Dimension::Length);
+  w.material = readMaterial(b.map("material"));
+  YamlMap ch = b.map("clamp_holes");
+  w.clamp_holes = ch.integer("count");
+  if (w.clamp_holes != 0 && w.clamp_holes != 4) ch.fail("count", "expected 0 or 4 (one near each corner)");
+  w.clamp_hole_diameter_mm = positive(ch, "diameter", Dimension::Length);
+  w.clamp_hole_inset_mm = positive(ch, "inset", Dimension::Length);
+  if (!(w.clamp_hole_inset_mm > w.clamp_hole_diameter_mm / 2))
+    ch.fail("inset", "a hole " + formatNumber(w.clamp_hole_inset_mm) + " mm in from the edges would break out of the blank (radius " +
+                         formatNumber(w.clamp_hole_diameter_mm / 2) + " mm)");
+  ch.finish();
+  b.finish();
+
+  YamlMap fx = root.map("fixture");
+  w.fixture_diameter_mm = positive(fx, "diameter", Dimension::Length);
+  w.fixture_height_mm = positive(fx, "height", Dimension::Length);
+  fx.finish();
+
+  w.tools = readCuttingTools(root, "tools");
+  w.finishing_tool = root.integer("finishing_tool");
+  const CuttingTool* tool = nullptr;
+  for (const auto& t : w.tools)
+    if (t.number == w.finishing_tool) tool = &t;
+  if (!tool) root.fail("finishing_tool", "tool T" + std::to_string(w.finishing_tool) + " is not in the tools list");
+
+  for (auto& s : root.mapList("steps")) {
+    SwStep st;
+    st.size_mm = positive(s, "size", Dimension::Length);
+    st.floor_depth_mm = positive(s, "floor_depth", Dimension::Length);
+    if (!w.steps.empty() && !(st.floor_depth_mm > w.steps.back().floor_depth_mm))
+      s.fail("floor_depth", "must be deeper than the floor of the step above (" + formatNumber(w.steps.back().floor_depth_mm) + " mm)");
+    s.finish();
+    w.steps.push_back(st);
+  }
+  if (w.steps.size() < 2 || w.steps.size() > 8) root.fail("steps", "expected 2 to 8 steps (the thesis's piece has 4)");
+  if (!(w.steps.back().floor_depth_mm < w.blank_height_mm))
+    root.fail("steps", "the deepest floor (" + formatNumber(w.steps.back().floor_depth_mm) + " mm) must lie above the blank's bottom (height " +
+                           formatNumber(w.blank_height_mm) + " mm)");
+  std::vector<double> sizes;
+  for (const auto& s : w.steps) sizes.push_back(s.size_mm);
+  checkSizes(root, "steps", sizes, w.blank_x_mm, w.blank_y_mm, tool->diameter_mm);
+  w.alternative_sizes_mm = root.quantityList("alternative_sizes", Dimension::Length);
+  if (w.alternative_sizes_mm.size() != w.steps.size())
+    root.fail("alternative_sizes", "expected one size per step (" + std::to_string(w.steps.size()) + ")");
+  checkSizes(root, "alternative_sizes", w.alternative_sizes_mm, w.blank_x_mm, w.blank_y_mm, tool->diameter_mm);
+  w.finishing_margin_mm = positive(root, "finishing_margin", Dimension::Length);
+
+  // The clamp holes stand in the blank's corners, outside the largest step and its tool path.
+  if (w.clamp_holes) {
+    const double c = w.centreXY();
+    const double corner = std::min(w.blank_x_mm, w.blank_y_mm) / 2 - w.clamp_hole_inset_mm;  // from the centre, per axis
+    const double clear = std::max(sizes.back(), w.alternative_sizes_mm.back()) / 2 + tool->diameter_mm + w.clamp_hole_diameter_mm / 2;
+    if (!(corner > clear))
+      root.fail("blank", "the clamp holes at " + formatNumber(corner) + " mm from the centre (" + formatNumber(c) + ", " + formatNumber(c) +
+                             ") along X and Y cut into the largest step's tool path (clear beyond " + formatNumber(clear) + " mm)");
+  }
+
+  YamlMap pr = root.map("procedure");
+  w.alignment_tolerance_mm = positive(pr, "alignment_tolerance", Dimension::Length);
+  w.off_before_s = pr.quantity("machine_off_before", Dimension::Duration);
+  w.off_after_s = pr.quantity("machine_off_before_probing", Dimension::Duration);
+  if (w.off_before_s < 0) pr.fail("machine_off_before", "must not be negative");
+  if (w.off_after_s < 0) pr.fail("machine_off_before_probing", "must not be negative");
+  YamlMap wu = pr.map("warm_up");
+  w.warm_up_idle_s = positive(wu, "spindle_idle", Dimension::Duration);
+  w.warm_up_axis_manoeuvre = wu.boolean("axis_manoeuvre");
+  wu.finish();
+  pr.finish();
+
+  for (auto& e : root.mapList("experiments")) {
+    const int line = e.line();
+    SwExperiment x = readExperiment(e, w.steps.size());
+    if (w.experiment(x.id)) throw InputError(path, line, "experiments: " + x.id + " is listed twice");
+    w.experiments.push_back(std::move(x));
+  }
+  w.cmm = readCmm(root.map("cmm"));
+  root.finish();
+  return w;
+}
+
+std::vector<NominalFeature> nominalFeatures(const SteppedWorkpiece& w, const std::vector<double>& sizes_mm) {
+  std::vector<double> sizes = sizes_mm;
+  if (sizes.empty())
+    for (const auto& s : w.steps) sizes.push_back(s.size_mm);
+  if (sizes.size() != w.steps.size())
+    throw InputError(w.file, 0, "nominalFeatures: " + std::to_string(sizes.size()) + " sizes for " + std::to_string(w.steps.size()) + " steps");
+  // The steps are centred on the top step's centre, whatever set of sizes is cut (the origin
+  // stays at the shipped top step's corner, notes §1.2).
+  const double c = w.centreXY();
+  std::vector<NominalFeature> out;
+  NominalFeature top;
+  top.id = "TOP";
+  top.kind = "plane";
+  top.role = "datum_top";
+  top.group = "datum";
+  top.point_mm = Vector3d(c, c, 0);
+  top.direction = Vector3d::UnitZ();
+  top.u = Vector3d::UnitX();
+  top.half_u_mm = top.half_v_mm = sizes.front() / 2;
+  out.push_back(top);
+  for (std::size_t k = 0; k < sizes.size(); ++k) {
+    const double half = sizes[k] / 2;
+    const double z_top = k == 0 ? 0.0 : -w.steps[k - 1].floor_depth_mm;
+    const double z_floor = -w.steps[k].floor_depth_mm;
+    const std::string group = "S" + std::to_string(k + 1);
+    struct Side {
+      const char* name;
+      Vector3d n, u;
+    };
+    for (const Side& s : {Side{"XP", Vector3d::UnitX(), Vector3d::UnitY()}, Side{"XN", -Vector3d::UnitX(), -Vector3d::UnitY()},
+                          Side{"YP", Vector3d::UnitY(), -Vector3d::UnitX()}, Side{"YN", -Vector3d::UnitY(), Vector3d::UnitX()}}) {
+      NominalFeature f;
+      f.id = group + "_" + s.name;
+      f.kind = "plane";
+      f.role = "wall";
+      f.group = group;
+      f.index = static_cast<int>(k + 1);
+      f.direction = s.n;
+      f.u = s.u;  // along the wall; v = n x u is then +Z for every side
+      f.point_mm = Vector3d(c, c, (z_top + z_floor) / 2) + half * s.n;
+      f.half_u_mm = half;
+      f.half_v_mm = (z_top - z_floor) / 2;
+      f.angle_deg = radToDeg(std::atan2(s.n.y(), s.n.x()));
+      out.push_back(f);
+    }
+    // The floor: a square ring from this step out to the next (the blank's edge for the last).
+    const double outer = k + 1 < sizes.size() ? sizes[k + 1] / 2 : std::min(w.blank_x_mm, w.blank_y_mm) / 2;
+    NominalFeature fl;
+    fl.id = group + "_F";
+    fl.kind = "plane";
+    fl.role = "floor";
+    fl.group = group;
+    fl.index = static_cast<int>(k + 1);
+    fl.point_mm = Vector3d(c, c, z_floor);
+    fl.direction = Vector3d::UnitZ();
+    fl.u = Vector3d::UnitX();
+    fl.half_u_mm = fl.half_v_mm = (half + outer) / 2;  // the ring's mid-line square
+    fl.radius_mm = (outer - half) / 2;                 // half the ring's width (probe points keep inside it)
+    out.push_back(fl);
+  }
+  return out;
+}
+
+Workpiece steppedWorkpieceStock(const SteppedWorkpiece& w) {
+  Workpiece s;
+  s.file = w.file;
+  s.name = w.name;
+  const double c = w.centreXY();
+  // The blank before roughing: its top face is the finished top plus nothing (the top is
+  // faced at z 0 in the first operation, L739); the finishing margin lives in the roughing
+  // program, not in the blank.
+  s.stock_min_mm = Vector3d(c - w.blank_x_mm / 2, c - w.blank_y_mm / 2, -w.blank_height_mm);
+  s.stock_max_mm = Vector3d(c + w.blank_x_mm / 2, c + w.blank_y_mm / 2, 0);
+  const double corner = std::min(w.blank_x_mm, w.blank_y_mm) / 2 - w.clamp_hole_inset_mm;
+  for (int i = 0; i < w.clamp_holes; ++i) {
+    const double sx = (i == 0 || i == 3) ? 1 : -1, sy = i < 2 ? 1 : -1;
+    s.holes.push_back({Vector2d(c + sx * corner, c + sy * corner), w.clamp_hole_diameter_mm / 2, -w.blank_height_mm - 1, 1,
+                       "clamp hole " + std::to_string(i + 1)});
+  }
+  s.obstacles.push_back({Vector2d(c, c), w.fixture_diameter_mm / 2, -w.blank_height_mm - w.fixture_height_mm, -w.blank_height_mm,
+                         "fixture"});
+  s.material = w.material;
+  s.tools = w.tools;
+  s.cmm = w.cmm;
+  return s;
+}
+
+}  // namespace probeloop::parts

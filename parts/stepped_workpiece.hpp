@@ -1,0 +1,96 @@
+// The stepped workpiece of seed 000 (Yaqoob, MSc thesis, Sabanci University 2017): the
+// description (YAML, kind: stepped_workpiece; docs/formats.md#stepped-workpiece), the
+// geometry it implies (the top and, per step, four walls and a floor) and the experiments
+// W1-W8 of Table 4.1 as data (notes/seed000.md §1-§3). Issue 14, first part: the planner,
+// the simulation and the error separation build on this.
+//
+// Part frame (notes §1.2, derived from Tables 5.1/5.3: the drawing, Fig. 3.2, is lost): origin
+// at a corner of the top step in its top face, X and Y along its walls, Z up. Every step is a
+// square centred on (c, c), c = half the top step's size (15 mm for the shipped 30 mm); step
+// k = 1..4 stands from the floor of step k-1 (the top face for k = 1) down to its own floor
+// at depth floor_depth[k]. Lengths in mm, feeds in mm/min, speeds in rpm, times in s.
+//
+// Features (parts/feature.hpp), ids fixed by the step and the side:
+// - TOP: the top face of step 1 (the Z reference of the 9-point top plane, L1124);
+// - S<k>_XP, S<k>_XN, S<k>_YP, S<k>_YN: the walls of step k with outward normals +X, -X, +Y,
+//   -Y (group S<k>, the X width is XP - XN, the Y width YP - YN);
+// - S<k>_F: the floor around step k at -floor_depth[k], a square ring out to the next step
+//   (or the blank's edge for the last); its nominal plane is the ring's mid-line square.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "parts/feature.hpp"
+#include "parts/workpiece.hpp"
+
+namespace probeloop::parts {
+
+struct SwStep {
+  double size_mm = 0;         // outer X and Y of the square (Table 5.3)
+  double floor_depth_mm = 0;  // below the top face (Table 5.3 "Z1", notes §1.2)
+};
+
+// One step's cutting conditions in one experiment (Table 4.1).
+struct SwCutConditions {
+  double feed_xy_mm_per_min = 0, feed_z_mm_per_min = 0;
+  double spindle_speed_rpm = 0;
+};
+
+// One experiment W1..W8 (Tables 3.1 and 4.1): per-step conditions and how the tool gets from
+// one wall to the next.
+struct SwExperiment {
+  std::string id;          // W1 ... W8
+  std::string purpose;     // Table 3.1's "expected error changes", in words
+  // non_cutting: lift and move between walls at transition_feed (W1, W3, W4, W6-W8);
+  // fast: the same at a high transition feed (W2: 1200 mm/min in Table 3.1, 2400 in Eqs.
+  // 3.11-3.14 and L1708, unresolved in the source: the value is the description's);
+  // continuous: one path around each step at its cutting feed (W5, L896-900).
+  std::string transition;
+  double transition_feed_mm_per_min = 0;  // non_cutting and fast; 0 for continuous
+  double tool_runout_mm = 0;              // dial indicator (Table 4.1), compensated in the path (L973)
+  bool alternative_sizes = false;         // W2/W5 were cut to 29/44/79/99 (Tables 5.6/5.7)
+  std::vector<SwCutConditions> steps;     // one per step, in step order
+};
+
+struct SteppedWorkpiece {
+  std::string file, name;
+  // Blank (our choice: the source gives none) and fixture (a circular stainless steel plate
+  // with threaded holes, turned on both faces, L719-733; its size is our choice).
+  double blank_x_mm = 0, blank_y_mm = 0, blank_height_mm = 0;
+  WorkpieceMaterial material;
+  int clamp_holes = 0;                 // drilled at full diameter in roughing (L697)
+  double clamp_hole_diameter_mm = 0;
+  double clamp_hole_inset_mm = 0;      // from the blank's corners along both diagonals' axes
+  double fixture_diameter_mm = 0, fixture_height_mm = 0;
+  std::vector<SwStep> steps;           // top (1) to bottom; sizes grow, depths grow
+  std::vector<double> alternative_sizes_mm;  // the W2/W5 set (29/44/79/99)
+  double finishing_margin_mm = 0;      // left on every face by roughing (L695)
+  std::vector<CuttingTool> tools;
+  int finishing_tool = 0;
+  // The procedure (Sec. 4.1, notes §2.3): alignment, machine off before, warm-up after each
+  // step (spindle idle at the experiment's speed, then the axis manoeuvre that replays the
+  // path without cutting), machine off before probing.
+  double alignment_tolerance_mm = 0;   // walls parallel to X/Y within 5 um (L968)
+  double off_before_s = 0, off_after_s = 0;
+  double warm_up_idle_s = 0;           // 30 min (L992)
+  bool warm_up_axis_manoeuvre = false; // L739-741
+  std::vector<SwExperiment> experiments;
+  CmmSpec cmm;
+
+  const SwExperiment* experiment(const std::string& id) const;
+  // The step sizes an experiment cuts (the standard set or the alternative one).
+  std::vector<double> sizesFor(const SwExperiment& e) const;
+  double centreXY() const { return steps.front().size_mm / 2; }
+};
+
+SteppedWorkpiece loadSteppedWorkpiece(const std::string& path);
+
+// TOP, then per step its four walls and its floor (see above), for the given step sizes
+// (default: the description's own).
+std::vector<NominalFeature> nominalFeatures(const SteppedWorkpiece& w, const std::vector<double>& sizes_mm = {});
+
+// The blank on its fixture as the simulator machines it: a box centred on (c, c) from the top
+// face down, clamp holes through it, the fixture below as a collision body.
+Workpiece steppedWorkpieceStock(const SteppedWorkpiece& w);
+
+}  // namespace probeloop::parts
