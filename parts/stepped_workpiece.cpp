@@ -27,6 +27,15 @@ std::vector<double> SteppedWorkpiece::sizesFor(const SwExperiment& e) const {
 
 namespace {
 
+// Near the blank's corners, `inset` in from both edges.
+std::vector<Vector2d> clampHoleCentres(const SteppedWorkpiece& w) {
+  const double c = w.centreXY(), corner = std::min(w.blank_x_mm, w.blank_y_mm) / 2 - w.clamp_hole_inset_mm;
+  std::vector<Vector2d> out;
+  for (int i = 0; i < w.clamp_holes; ++i)
+    out.emplace_back(c + ((i == 0 || i == 3) ? corner : -corner), c + (i < 2 ? corner : -corner));
+  return out;
+}
+
 double positive(YamlMap& m, const std::string& key, Dimension dim) {
   const double v = m.quantity(key, dim);
   if (!(v > 0)) m.fail(key, "must be positive");
@@ -171,9 +180,80 @@ SteppedWorkpiece loadSteppedWorkpiece(const std::string& path) {
     if (w.experiment(x.id)) throw InputError(path, line, "experiments: " + x.id + " is listed twice");
     w.experiments.push_back(std::move(x));
   }
+  YamlMap pb = root.map("probing");
+  w.probing.wall_positions = pb.numberList("wall_positions");
+  for (double f : w.probing.wall_positions)
+    if (!(f > -1 && f < 1)) pb.fail("wall_positions", "expected fractions of the wall's half length, strictly between -1 and 1");
+  w.probing.wall_levels = pb.numberList("wall_levels");
+  for (double f : w.probing.wall_levels)
+    if (!(f > 0 && f < 1)) pb.fail("wall_levels", "expected fractions of the wall's height below its top edge, strictly between 0 and 1");
+  if (w.probing.wall_positions.size() * w.probing.wall_levels.size() < 3)
+    pb.fail("wall_positions", "a wall's plane needs at least 3 points (positions x levels)");
+  w.probing.top_grid = pb.number("top_grid");
+  if (!(w.probing.top_grid > 0 && w.probing.top_grid < 1)) pb.fail("top_grid", "expected a fraction of the top's half size, between 0 and 1");
+  w.probing.tip_diameter_mm = positive(pb, "tip_diameter", Dimension::Length);
+  w.probing.feed_mm_per_min = positive(pb, "feed", Dimension::Feed);
+  w.probing.positioning_feed_mm_per_min = positive(pb, "positioning_feed", Dimension::Feed);
+  w.probing.approach_mm = positive(pb, "approach", Dimension::Length);
+  w.probing.overtravel_mm = positive(pb, "overtravel", Dimension::Length);
+  w.probing.clearance_mm = positive(pb, "clearance", Dimension::Length);
+  w.probing.repeatability_mm = positive(pb, "repeatability", Dimension::Length);
+  pb.finish();
   w.cmm = readCmm(root.map("cmm"));
   root.finish();
+  // Every layout must fit every size set the experiments cut (the shipped and the W2/W5 one).
+  try {
+    probePoints(w, nominalFeatures(w));
+    probePoints(w, nominalFeatures(w, w.alternative_sizes_mm));
+  } catch (const InputError& e) {
+    throw InputError(path, 0, std::string("probing: ") + e.what());
+  }
   return w;
+}
+
+std::vector<SwProbePoint> probePoints(const SteppedWorkpiece& w, const std::vector<NominalFeature>& features) {
+  const double keep = w.probing.tip_diameter_mm / 2 + 0.5;  // from a face's edges
+  std::vector<SwProbePoint> out;
+  auto add = [&](const NominalFeature& f, int& n, const Vector3d& p) {
+    // Inside the face: within its extent less `keep` along u and v (a floor's ring: across it).
+    // Inside the face by `keep`: a floor's points lie on its ring's mid-line, half the ring's
+    // width from the step and from the next; the others within their extent along u and v.
+    const Vector3d d = p - f.point_mm;
+    bool ok = f.role == "floor" ? f.radius_mm >= keep
+                                : std::abs(d.dot(f.u)) <= f.half_u_mm - keep + 1e-9 && std::abs(d.dot(f.v())) <= f.half_v_mm - keep + 1e-9;
+    for (const auto& c : clampHoleCentres(w))
+      if ((p.head<2>() - c).norm() < w.clamp_hole_diameter_mm / 2 + keep) ok = false;
+    if (!ok)
+      throw InputError(w.file, 0, "feature " + f.id + ": point " + std::to_string(n + 1) + " lies within " + formatNumber(keep) +
+                                      " mm (the ball's radius + 0.5 mm) of the face's edge; move it inward or use a smaller ball");
+    out.push_back({f.id, ++n, p, f.direction});
+  };
+  for (const auto& f : features) {
+    int n = 0;
+    if (f.role == "datum_top") {
+      const double g = w.probing.top_grid;
+      for (double b : {-g, 0.0, g})
+        for (double a : {-g, 0.0, g}) add(f, n, f.point_mm + a * f.half_u_mm * f.u + b * f.half_v_mm * f.v());
+    } else if (f.role == "wall") {
+      const double top = f.point_mm.z() + f.half_v_mm, height = 2 * f.half_v_mm;
+      for (double level : w.probing.wall_levels)
+        for (double a : w.probing.wall_positions) {
+          Vector3d p = f.point_mm + a * f.half_u_mm * f.u;
+          p.z() = top - level * height;
+          add(f, n, p);
+        }
+    } else if (f.role == "floor") {
+      // The ring's mid-line square (half size h about the centre): per side (+X, +Y, -X, -Y)
+      // the points at -h/2 and +h/2 along it, then the middle of the +X side.
+      const double h = f.half_u_mm;
+      const Vector3d c = f.point_mm;
+      const Vector3d x = Vector3d::UnitX(), y = Vector3d::UnitY();
+      for (const auto& [side, along] : {std::pair{x, y}, std::pair{y, Vector3d(-x)}, std::pair{Vector3d(-x), Vector3d(-y)}, std::pair{Vector3d(-y), x}})
+        for (double s : {-0.5, 0.5}) add(f, n, c + h * side + s * h * along);
+      add(f, n, c + h * x);
+    }
+  }
+  return out;
 }
 
 std::vector<NominalFeature> nominalFeatures(const SteppedWorkpiece& w, const std::vector<double>& sizes_mm) {
@@ -249,12 +329,9 @@ Workpiece steppedWorkpieceStock(const SteppedWorkpiece& w) {
   // program, not in the blank.
   s.stock_min_mm = Vector3d(c - w.blank_x_mm / 2, c - w.blank_y_mm / 2, -w.blank_height_mm);
   s.stock_max_mm = Vector3d(c + w.blank_x_mm / 2, c + w.blank_y_mm / 2, 0);
-  const double corner = std::min(w.blank_x_mm, w.blank_y_mm) / 2 - w.clamp_hole_inset_mm;
-  for (int i = 0; i < w.clamp_holes; ++i) {
-    const double sx = (i == 0 || i == 3) ? 1 : -1, sy = i < 2 ? 1 : -1;
-    s.holes.push_back({Vector2d(c + sx * corner, c + sy * corner), w.clamp_hole_diameter_mm / 2, -w.blank_height_mm - 1, 1,
-                       "clamp hole " + std::to_string(i + 1)});
-  }
+  int i = 0;
+  for (const auto& h : clampHoleCentres(w))
+    s.holes.push_back({h, w.clamp_hole_diameter_mm / 2, -w.blank_height_mm - 1, 1, "clamp hole " + std::to_string(++i)});
   s.obstacles.push_back({Vector2d(c, c), w.fixture_diameter_mm / 2, -w.blank_height_mm - w.fixture_height_mm, -w.blank_height_mm,
                          "fixture"});
   s.material = w.material;

@@ -52,6 +52,28 @@ struct SwExperiment {
   std::vector<SwCutConditions> steps;     // one per step, in step order
 };
 
+// How the piece is probed, on the machine and on the CMM (Sec. 3.4, L757-800; notes §3): per
+// wall 3 positions x 2 Z levels, per floor and on the top 9 points, approach along the
+// outward normal. The layout within a face is ours (Fig. 3.8 is lost): docs/stepped-workpiece.md.
+struct SwProbing {
+  std::vector<double> wall_positions;  // along the wall, fractions of its half length (-1..1)
+  std::vector<double> wall_levels;     // below the wall's top edge, fractions of its height (0..1)
+  double top_grid = 0;                 // the top's 3 x 3 grid at -g, 0, +g of its half size
+  double tip_diameter_mm = 0;          // the stylus ball: every point keeps its radius + 0.5 mm from the face's edges
+  double feed_mm_per_min = 0, positioning_feed_mm_per_min = 0;
+  double approach_mm = 0, overtravel_mm = 0, clearance_mm = 0;
+  double repeatability_mm = 0;         // +-2 um on W8 step 3 (L769), read as 2 sigma
+};
+
+// One planned contact on a face: the nominal point on the face, the outward normal (the probe
+// approaches against it), the feature and its 1-based number within the feature.
+struct SwProbePoint {
+  std::string feature;
+  int point = 0;
+  Eigen::Vector3d contact_mm = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+};
+
 struct SteppedWorkpiece {
   std::string file, name;
   // Blank (our choice: the source gives none) and fixture (a circular stainless steel plate
@@ -75,6 +97,7 @@ struct SteppedWorkpiece {
   double warm_up_idle_s = 0;           // 30 min (L992)
   bool warm_up_axis_manoeuvre = false; // L739-741
   std::vector<SwExperiment> experiments;
+  SwProbing probing;
   CmmSpec cmm;
 
   const SwExperiment* experiment(const std::string& id) const;
@@ -88,6 +111,13 @@ SteppedWorkpiece loadSteppedWorkpiece(const std::string& path);
 // TOP, then per step its four walls and its floor (see above), for the given step sizes
 // (default: the description's own).
 std::vector<NominalFeature> nominalFeatures(const SteppedWorkpiece& w, const std::vector<double>& sizes_mm = {});
+
+// Every planned contact for the given features (nominalFeatures of one size set), in the
+// features' order: TOP 9 (3 x 3 grid), per wall positions x levels (level by level, along the
+// wall in the direction of its u), per floor 9 on the ring's mid-line: two per side at half
+// the side's half length either way of its middle, and the middle of the +X side. InputError
+// when a point would lie closer to a face's edge than the stylus ball's radius + 0.5 mm.
+std::vector<SwProbePoint> probePoints(const SteppedWorkpiece& w, const std::vector<NominalFeature>& features);
 
 // The blank on its fixture as the simulator machines it: a box centred on (c, c) from the top
 // face down, clamp holes through it, the fixture below as a collision body.

@@ -184,6 +184,61 @@ TEST(SteppedWorkpiece, TheStockIsTheBlankOnItsFixture) {
   EXPECT_THROW(expansionLevers(piece), InputError);  // no evaluation yet
 }
 
+// Sec. 3.4 / notes §3: per wall 3 positions x 2 Z levels, 9 per floor, 9 on the top (L1124);
+// the positions within a face are the description's (0.6 of the half length, 0.2 and 0.8 of
+// the height): 9 + 16 x 6 + 4 x 9 = 141 contacts, each on its face.
+TEST(SteppedWorkpiece, ProbePointsFollowSection34) {
+  const auto w = loadSteppedWorkpiece(shipped());
+  for (const auto& sizes : {std::vector<double>{}, w.alternative_sizes_mm}) {
+    const auto f = nominalFeatures(w, sizes);
+    const auto pts = probePoints(w, f);
+    EXPECT_EQ(pts.size(), 141u);
+    std::map<std::string, int> per;
+    for (const auto& p : pts) {
+      ++per[p.feature];
+      const auto& x = byId(f, p.feature);
+      EXPECT_NEAR((p.contact_mm - x.point_mm).dot(x.direction), 0, 1e-12) << p.feature << " " << p.point;
+      EXPECT_EQ(p.normal, x.direction);
+    }
+    EXPECT_EQ(per["TOP"], 9);
+    for (int k = 1; k <= 4; ++k) {
+      for (const char* side : {"_XP", "_XN", "_YP", "_YN"}) EXPECT_EQ(per["S" + std::to_string(k) + side], 6);
+      EXPECT_EQ(per["S" + std::to_string(k) + "_F"], 9);
+    }
+  }
+  const auto pts = probePoints(w, nominalFeatures(w));
+  std::vector<Vector3d> s1xp, s4yn, s1f;
+  for (const auto& p : pts) {
+    if (p.feature == "S1_XP") s1xp.push_back(p.contact_mm);
+    if (p.feature == "S4_YN") s4yn.push_back(p.contact_mm);
+    if (p.feature == "S1_F") s1f.push_back(p.contact_mm);
+  }
+  // S1_XP: x = 30, y = 15 + (-0.6, 0, 0.6) x 15 along +Y, z = -0.2 x 9 and -0.8 x 9.
+  const std::vector<Vector3d> want{{30, 6, -1.8}, {30, 15, -1.8}, {30, 24, -1.8}, {30, 6, -7.2}, {30, 15, -7.2}, {30, 24, -7.2}};
+  ASSERT_EQ(s1xp.size(), want.size());
+  for (std::size_t i = 0; i < want.size(); ++i) EXPECT_LT((s1xp[i] - want[i]).norm(), 1e-12) << i;
+  // S4_YN: y = -34.5, its wall from z -29 to -37: levels at -30.6 and -35.4.
+  for (const auto& p : s4yn) {
+    EXPECT_DOUBLE_EQ(p.y(), -34.5);
+    EXPECT_TRUE(std::abs(p.z() + 30.6) < 1e-12 || std::abs(p.z() + 35.4) < 1e-12) << p.z();
+  }
+  // S1_F: the ring between the 30 and 45 squares at z -9, points on its mid-line (18.75 from
+  // the centre), two per side and the middle of +X: 3 points with x - 15 = 18.75.
+  int on_xp = 0;
+  for (const auto& p : s1f) {
+    EXPECT_DOUBLE_EQ(p.z(), -9);
+    EXPECT_NEAR(std::max(std::abs(p.x() - 15), std::abs(p.y() - 15)), 18.75, 1e-12);
+    on_xp += std::abs(p.x() - 33.75) < 1e-12;
+  }
+  EXPECT_EQ(on_xp, 3);
+  // A 16 mm ball does not fit the 7.5 mm ring of step 1's floor.
+  expectRefused(variant("tip_diameter: 2 mm", "tip_diameter: 16 mm"), "probing: ");
+  expectRefused(variant("tip_diameter: 2 mm", "tip_diameter: 16 mm"), "lies within 8.5 mm (the ball's radius + 0.5 mm) of the face's edge");
+  expectRefused(variant("wall_positions: [-0.6, 0, 0.6]", "wall_positions: [-0.6, 0, 1.2]"), "strictly between -1 and 1");
+  // 0.95 of the half length of the 30 mm step: 0.75 mm from its corner, within 1.5 mm.
+  expectRefused(variant("wall_positions: [-0.6, 0, 0.6]", "wall_positions: [-0.95, 0, 0.6]"), "feature S1_XP: point 1 lies within 1.5 mm");
+}
+
 TEST(SteppedWorkpiece, BadDescriptionsAreRefusedWithTheLine) {
   const std::string small = refusal(variant("{size: 45 mm, floor_depth: 19 mm}", "{size: 25 mm, floor_depth: 19 mm}"));
   EXPECT_TRUE(std::regex_search(small, std::regex(R"(\.yaml:[0-9]+: steps: step 2 \(25 mm\) must be larger than step 1)"))) << small;
