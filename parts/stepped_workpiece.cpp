@@ -36,12 +36,6 @@ std::vector<Vector2d> clampHoleCentres(const SteppedWorkpiece& w) {
   return out;
 }
 
-double positive(YamlMap& m, const std::string& key, Dimension dim) {
-  const double v = m.quantity(key, dim);
-  if (!(v > 0)) m.fail(key, "must be positive");
-  return v;
-}
-
 // Sizes that grow from the top step down and leave a wall on every side of the next step
 // (a step no larger than the one above it would have no floor to probe).
 void checkSizes(YamlMap& m, const std::string& key, const std::vector<double>& sizes, double blank_x, double blank_y,
@@ -68,7 +62,7 @@ SwExperiment readExperiment(YamlMap e, std::size_t n_steps) {
   if (x.transition == "continuous") {
     if (e.has("transition_feed")) e.fail("transition_feed", "a continuous path has no transitions: leave it out");
   } else {
-    x.transition_feed_mm_per_min = positive(e, "transition_feed", Dimension::Feed);
+    x.transition_feed_mm_per_min = e.positiveQuantity("transition_feed", Dimension::Feed);
   }
   x.tool_runout_mm = e.quantity("tool_runout", Dimension::Length);
   if (!(x.tool_runout_mm >= 0 && x.tool_runout_mm < 0.1)) e.fail("tool_runout", "expected 0 to 0.1 mm (Table 4.1: 0.004)");
@@ -79,9 +73,9 @@ SwExperiment readExperiment(YamlMap e, std::size_t n_steps) {
                         std::to_string(list.size()));
   for (auto& s : list) {
     SwCutConditions c;
-    c.feed_xy_mm_per_min = positive(s, "feed_xy", Dimension::Feed);
-    c.feed_z_mm_per_min = positive(s, "feed_z", Dimension::Feed);
-    c.spindle_speed_rpm = positive(s, "spindle_speed", Dimension::RotSpeed);
+    c.feed_xy_mm_per_min = s.positiveQuantity("feed_xy", Dimension::Feed);
+    c.feed_z_mm_per_min = s.positiveQuantity("feed_z", Dimension::Feed);
+    c.spindle_speed_rpm = s.positiveQuantity("spindle_speed", Dimension::RotSpeed);
     s.finish();
     x.steps.push_back(c);
   }
@@ -105,13 +99,13 @@ SteppedWorkpiece loadSteppedWorkpiece(const std::string& path) {
     w.blank_x_mm = size[0];
     w.blank_y_mm = size[1];
   }
-  w.blank_height_mm = positive(b, "height", Dimension::Length);
+  w.blank_height_mm = b.positiveQuantity("height", Dimension::Length);
   w.material = readMaterial(b.map("material"));
   YamlMap ch = b.map("clamp_holes");
   w.clamp_holes = ch.integer("count");
   if (w.clamp_holes != 0 && w.clamp_holes != 4) ch.fail("count", "expected 0 or 4 (one near each corner)");
-  w.clamp_hole_diameter_mm = positive(ch, "diameter", Dimension::Length);
-  w.clamp_hole_inset_mm = positive(ch, "inset", Dimension::Length);
+  w.clamp_hole_diameter_mm = ch.positiveQuantity("diameter", Dimension::Length);
+  w.clamp_hole_inset_mm = ch.positiveQuantity("inset", Dimension::Length);
   if (!(w.clamp_hole_inset_mm > w.clamp_hole_diameter_mm / 2))
     ch.fail("inset", "a hole " + formatNumber(w.clamp_hole_inset_mm) + " mm in from the edges would break out of the blank (radius " +
                          formatNumber(w.clamp_hole_diameter_mm / 2) + " mm)");
@@ -119,8 +113,8 @@ SteppedWorkpiece loadSteppedWorkpiece(const std::string& path) {
   b.finish();
 
   YamlMap fx = root.map("fixture");
-  w.fixture_diameter_mm = positive(fx, "diameter", Dimension::Length);
-  w.fixture_height_mm = positive(fx, "height", Dimension::Length);
+  w.fixture_diameter_mm = fx.positiveQuantity("diameter", Dimension::Length);
+  w.fixture_height_mm = fx.positiveQuantity("height", Dimension::Length);
   fx.finish();
 
   w.tools = readCuttingTools(root, "tools");
@@ -132,8 +126,8 @@ SteppedWorkpiece loadSteppedWorkpiece(const std::string& path) {
 
   for (auto& s : root.mapList("steps")) {
     SwStep st;
-    st.size_mm = positive(s, "size", Dimension::Length);
-    st.floor_depth_mm = positive(s, "floor_depth", Dimension::Length);
+    st.size_mm = s.positiveQuantity("size", Dimension::Length);
+    st.floor_depth_mm = s.positiveQuantity("floor_depth", Dimension::Length);
     if (!w.steps.empty() && !(st.floor_depth_mm > w.steps.back().floor_depth_mm))
       s.fail("floor_depth", "must be deeper than the floor of the step above (" + formatNumber(w.steps.back().floor_depth_mm) + " mm)");
     s.finish();
@@ -150,7 +144,7 @@ SteppedWorkpiece loadSteppedWorkpiece(const std::string& path) {
   if (w.alternative_sizes_mm.size() != w.steps.size())
     root.fail("alternative_sizes", "expected one size per step (" + std::to_string(w.steps.size()) + ")");
   checkSizes(root, "alternative_sizes", w.alternative_sizes_mm, w.blank_x_mm, w.blank_y_mm, tool->diameter_mm);
-  w.finishing_margin_mm = positive(root, "finishing_margin", Dimension::Length);
+  w.finishing_margin_mm = root.positiveQuantity("finishing_margin", Dimension::Length);
 
   // The clamp holes stand in the blank's corners, outside the largest step and its tool path.
   if (w.clamp_holes) {
@@ -163,13 +157,13 @@ SteppedWorkpiece loadSteppedWorkpiece(const std::string& path) {
   }
 
   YamlMap pr = root.map("procedure");
-  w.alignment_tolerance_mm = positive(pr, "alignment_tolerance", Dimension::Length);
+  w.alignment_tolerance_mm = pr.positiveQuantity("alignment_tolerance", Dimension::Length);
   w.off_before_s = pr.quantity("machine_off_before", Dimension::Duration);
   w.off_after_s = pr.quantity("machine_off_before_probing", Dimension::Duration);
   if (w.off_before_s < 0) pr.fail("machine_off_before", "must not be negative");
   if (w.off_after_s < 0) pr.fail("machine_off_before_probing", "must not be negative");
   YamlMap wu = pr.map("warm_up");
-  w.warm_up_idle_s = positive(wu, "spindle_idle", Dimension::Duration);
+  w.warm_up_idle_s = wu.positiveQuantity("spindle_idle", Dimension::Duration);
   w.warm_up_axis_manoeuvre = wu.boolean("axis_manoeuvre");
   wu.finish();
   pr.finish();
@@ -191,13 +185,13 @@ SteppedWorkpiece loadSteppedWorkpiece(const std::string& path) {
     pb.fail("wall_positions", "a wall's plane needs at least 3 points (positions x levels)");
   w.probing.top_grid = pb.number("top_grid");
   if (!(w.probing.top_grid > 0 && w.probing.top_grid < 1)) pb.fail("top_grid", "expected a fraction of the top's half size, between 0 and 1");
-  w.probing.tip_diameter_mm = positive(pb, "tip_diameter", Dimension::Length);
-  w.probing.feed_mm_per_min = positive(pb, "feed", Dimension::Feed);
-  w.probing.positioning_feed_mm_per_min = positive(pb, "positioning_feed", Dimension::Feed);
-  w.probing.approach_mm = positive(pb, "approach", Dimension::Length);
-  w.probing.overtravel_mm = positive(pb, "overtravel", Dimension::Length);
-  w.probing.clearance_mm = positive(pb, "clearance", Dimension::Length);
-  w.probing.repeatability_mm = positive(pb, "repeatability", Dimension::Length);
+  w.probing.tip_diameter_mm = pb.positiveQuantity("tip_diameter", Dimension::Length);
+  w.probing.feed_mm_per_min = pb.positiveQuantity("feed", Dimension::Feed);
+  w.probing.positioning_feed_mm_per_min = pb.positiveQuantity("positioning_feed", Dimension::Feed);
+  w.probing.approach_mm = pb.positiveQuantity("approach", Dimension::Length);
+  w.probing.overtravel_mm = pb.positiveQuantity("overtravel", Dimension::Length);
+  w.probing.clearance_mm = pb.positiveQuantity("clearance", Dimension::Length);
+  w.probing.repeatability_mm = pb.positiveQuantity("repeatability", Dimension::Length);
   pb.finish();
   w.cmm = readCmm(root.map("cmm"));
   root.finish();

@@ -13,27 +13,16 @@
 
 #include "core/error.hpp"
 #include "parts/test_piece.hpp"
+#include "parts/test_support.hpp"
 
 namespace probeloop::parts {
 namespace {
 
-namespace fs = std::filesystem;
 using Eigen::Vector3d;
 
 std::string shipped() { return std::string(PROBELOOP_SOURCE_DIR) + "/parts/stepped_workpiece.yaml"; }
 
-// The shipped file with one text replaced, in a fresh temporary file.
-std::string variant(const std::string& from, const std::string& to) {
-  std::ifstream in(shipped());
-  std::string s(std::istreambuf_iterator<char>(in), {});
-  const auto at = s.find(from);
-  if (at == std::string::npos) throw std::logic_error("no '" + from + "' in the shipped file");
-  s.replace(at, from.size(), to);
-  static int n = 0;
-  const auto p = fs::temp_directory_path() / ("probeloop-sw-" + std::to_string(::getpid()) + "-" + std::to_string(n++) + ".yaml");
-  std::ofstream(p) << s;
-  return p.string();
-}
+std::string variant(const std::string& from, const std::string& to) { return test::variantOf(shipped(), from, to); }
 
 std::string refusal(const std::string& file) {
   try {

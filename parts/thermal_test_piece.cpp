@@ -28,12 +28,6 @@ Vector2d point2(YamlMap& m, const std::string& key) {
   return {v[0], v[1]};
 }
 
-double positive(YamlMap& m, const std::string& key, Dimension dim) {
-  const double v = m.quantity(key, dim);
-  if (!(v > 0)) m.fail(key, "must be positive");
-  return v;
-}
-
 int toolNumber(YamlMap& m, const ThermalTestPiece& t, const std::string& key = "tool") {
   const int n = m.integer(key);
   if (!t.tool(n)) m.fail(key, "tool T" + std::to_string(n) + " is not in the tools list");
@@ -84,41 +78,41 @@ ThermalTestPiece loadThermalTestPiece(const std::string& path) {
   t.name = root.stringOr("name", "thermal test piece");
 
   YamlMap b = root.map("blank");
-  t.blank_diameter_mm = positive(b, "diameter", Dimension::Length);
-  t.blank_height_mm = positive(b, "height", Dimension::Length);
+  t.blank_diameter_mm = b.positiveQuantity("diameter", Dimension::Length);
+  t.blank_height_mm = b.positiveQuantity("height", Dimension::Length);
   t.material = readMaterial(b.map("material"));
   YamlMap bh = b.map("bolt_holes");
   t.bolt_holes = bh.integer("count");
-  t.bolt_circle_diameter_mm = positive(bh, "circle_diameter", Dimension::Length);
+  t.bolt_circle_diameter_mm = bh.positiveQuantity("circle_diameter", Dimension::Length);
   t.bolt_first_angle_deg = bh.quantity("first_angle", Dimension::Angle);
-  t.bolt_hole_diameter_mm = positive(bh, "diameter", Dimension::Length);
-  t.bolt_hole_depth_mm = positive(bh, "depth", Dimension::Length);
+  t.bolt_hole_diameter_mm = bh.positiveQuantity("diameter", Dimension::Length);
+  t.bolt_hole_depth_mm = bh.positiveQuantity("depth", Dimension::Length);
   if (t.bolt_holes < 0 || t.bolt_holes > 12) bh.fail("count", "expected 0..12 holes");
   bh.finish();
   b.finish();
 
   YamlMap fx = root.map("fixture");
   YamlMap ad = fx.map("adapter");
-  t.adapter_diameter_mm = positive(ad, "diameter", Dimension::Length);
-  t.adapter_height_mm = positive(ad, "height", Dimension::Length);
+  t.adapter_diameter_mm = ad.positiveQuantity("diameter", Dimension::Length);
+  t.adapter_height_mm = ad.positiveQuantity("height", Dimension::Length);
   ad.finish();
   YamlMap wa = fx.map("washers");
-  t.washer_diameter_mm = positive(wa, "diameter", Dimension::Length);
-  t.washer_thickness_mm = positive(wa, "thickness", Dimension::Length);
+  t.washer_diameter_mm = wa.positiveQuantity("diameter", Dimension::Length);
+  t.washer_thickness_mm = wa.positiveQuantity("thickness", Dimension::Length);
   wa.finish();
   fx.finish();
 
   t.tools = readCuttingTools(root, "tools");
 
   YamlMap pre = root.map("pre_machining");
-  t.pre_spindle_rpm = positive(pre, "spindle_speed", Dimension::RotSpeed);
-  t.pre_feed_mm_per_min = positive(pre, "feed", Dimension::Feed);
+  t.pre_spindle_rpm = pre.positiveQuantity("spindle_speed", Dimension::RotSpeed);
+  t.pre_feed_mm_per_min = pre.positiveQuantity("feed", Dimension::Feed);
   t.pre_machining_coolant = pre.boolean("coolant");
   YamlMap face = pre.map("face");
   t.face_tool = toolNumber(face, t);
-  t.face_depth_mm = positive(face, "depth", Dimension::Length);
-  t.face_stepover_mm = positive(face, "stepover", Dimension::Length);
-  t.face_feed_mm_per_min = positive(face, "feed", Dimension::Feed);
+  t.face_depth_mm = face.positiveQuantity("depth", Dimension::Length);
+  t.face_stepover_mm = face.positiveQuantity("stepover", Dimension::Length);
+  t.face_feed_mm_per_min = face.positiveQuantity("feed", Dimension::Feed);
   if (!(t.face_depth_mm < t.blank_height_mm)) face.fail("depth", "must be less than the blank height");
   if (!(t.face_stepover_mm < t.tool(t.face_tool)->diameter_mm))
     face.fail("stepover", "must be less than the tool diameter, or ridges stay between the passes");
@@ -126,10 +120,10 @@ ThermalTestPiece loadThermalTestPiece(const std::string& path) {
   const double H = t.finishedHeight();
   YamlMap bands = pre.map("bands");
   t.band_tool = toolNumber(bands, t);
-  t.band_feed_mm_per_min = positive(bands, "feed", Dimension::Feed);
+  t.band_feed_mm_per_min = bands.positiveQuantity("feed", Dimension::Feed);
   for (auto& bm : bands.mapList("list")) {
     TtpBand band;
-    band.diameter_mm = positive(bm, "diameter", Dimension::Length);
+    band.diameter_mm = bm.positiveQuantity("diameter", Dimension::Length);
     band.z_from_mm = bm.quantity("z_from", Dimension::Length);
     band.z_to_mm = bm.quantity("z_to", Dimension::Length);
     if (!(band.diameter_mm < t.blank_diameter_mm)) bm.fail("diameter", "must be smaller than the blank diameter");
@@ -147,21 +141,21 @@ ThermalTestPiece loadThermalTestPiece(const std::string& path) {
   t.mark_tool = toolNumber(mark, t);
   t.mark_from_mm = point2(mark, "from");
   t.mark_to_mm = point2(mark, "to");
-  t.mark_depth_mm = positive(mark, "depth", Dimension::Length);
+  t.mark_depth_mm = mark.positiveQuantity("depth", Dimension::Length);
   mark.finish();
   YamlMap yn = pre.map("y_notch");
   t.y_notch_tool = toolNumber(yn, t);
-  t.y_notch_width_mm = positive(yn, "width", Dimension::Length);
-  t.y_notch_depth_mm = positive(yn, "depth", Dimension::Length);
-  t.y_notch_step_mm = positive(yn, "step", Dimension::Length);
+  t.y_notch_width_mm = yn.positiveQuantity("width", Dimension::Length);
+  t.y_notch_depth_mm = yn.positiveQuantity("depth", Dimension::Length);
+  t.y_notch_step_mm = yn.positiveQuantity("step", Dimension::Length);
   if (!(t.tool(t.y_notch_tool)->diameter_mm <= t.y_notch_width_mm)) yn.fail("width", "the tool is wider than the notch");
   if (!(t.y_notch_depth_mm < H)) yn.fail("depth", "must be less than the finished height");
   yn.finish();
   YamlMap xn = pre.map("x_notch");
   t.x_notch_tool = toolNumber(xn, t);
-  t.x_notch_width_mm = positive(xn, "width", Dimension::Length);
-  t.x_notch_depth_mm = positive(xn, "depth", Dimension::Length);
-  t.x_notch_step_mm = positive(xn, "step", Dimension::Length);
+  t.x_notch_width_mm = xn.positiveQuantity("width", Dimension::Length);
+  t.x_notch_depth_mm = xn.positiveQuantity("depth", Dimension::Length);
+  t.x_notch_step_mm = xn.positiveQuantity("step", Dimension::Length);
   t.x_notch_allowance_mm = xn.quantity("finishing_allowance", Dimension::Length);
   if (!(t.x_notch_depth_mm < H)) xn.fail("depth", "must be less than the finished height");
   if (t.x_notch_allowance_mm < 0) xn.fail("finishing_allowance", "must not be negative");
@@ -169,9 +163,9 @@ ThermalTestPiece loadThermalTestPiece(const std::string& path) {
   YamlMap fa = pre.map("facets");
   t.facet_pre_tool = toolNumber(fa, t);
   t.facets_per_segment = fa.integer("per_segment");
-  t.facet_pitch_deg = positive(fa, "pitch", Dimension::Angle);
-  t.facet_apothem_mm = positive(fa, "apothem", Dimension::Length);
-  t.facet_allowance_mm = positive(fa, "allowance", Dimension::Length);
+  t.facet_pitch_deg = fa.positiveQuantity("pitch", Dimension::Angle);
+  t.facet_apothem_mm = fa.positiveQuantity("apothem", Dimension::Length);
+  t.facet_allowance_mm = fa.positiveQuantity("allowance", Dimension::Length);
   t.first_normal_angle_deg = fa.quantity("first_normal_angle", Dimension::Angle);
   if (t.facets_per_segment < 2) fa.fail("per_segment", "at least a reference and one measurement facet");
   {
@@ -188,14 +182,14 @@ ThermalTestPiece loadThermalTestPiece(const std::string& path) {
 
   YamlMap te = root.map("test");
   t.test_tool = toolNumber(te, t);
-  t.test_spindle_rpm = positive(te, "spindle_speed", Dimension::RotSpeed);
-  t.test_feed_mm_per_min = positive(te, "feed", Dimension::Feed);
+  t.test_spindle_rpm = te.positiveQuantity("spindle_speed", Dimension::RotSpeed);
+  t.test_feed_mm_per_min = te.positiveQuantity("feed", Dimension::Feed);
   t.test_coolant = te.boolean("coolant");
-  t.cut_depth_mm = positive(te, "cut_depth", Dimension::Length);
+  t.cut_depth_mm = te.positiveQuantity("cut_depth", Dimension::Length);
   if (t.cut_depth_mm > t.facet_allowance_mm + 1e-9) te.fail("cut_depth", "must not exceed the facets' allowance");
   YamlMap zp = te.map("z_paths");
   t.z_paths = zp.integer("count");
-  t.z_path_pitch_mm = positive(zp, "pitch", Dimension::Length);
+  t.z_path_pitch_mm = zp.positiveQuantity("pitch", Dimension::Length);
   t.z_path_x_from_mm = zp.quantity("x_from", Dimension::Length);
   t.z_path_x_to_mm = zp.quantity("x_to", Dimension::Length);
   if (t.z_paths != t.facets_per_segment)
@@ -215,7 +209,7 @@ ThermalTestPiece loadThermalTestPiece(const std::string& path) {
                            " mm notch without cutting its flanks (the datum of the CMM X direction; docs/thermal-test-piece.md)");
   }
   zp.finish();
-  t.facet_path_half_length_mm = positive(te, "facet_path_half_length", Dimension::Length);
+  t.facet_path_half_length_mm = te.positiveQuantity("facet_path_half_length", Dimension::Length);
   {
     const YAML::Node o = te.raw("order");
     if (!o.IsSequence()) te.fail("order", "expected a list of path/facet numbers");
@@ -235,9 +229,9 @@ ThermalTestPiece loadThermalTestPiece(const std::string& path) {
       te.fail("order", "must list each of 1.." + std::to_string(t.z_paths) + " once");
   }
   t.waiting_position_mm = point2(te, "waiting_position");
-  t.ring_radius_mm = positive(te, "ring_radius", Dimension::Length);
-  t.wait_s = positive(te, "wait", Dimension::Duration);
-  t.c_turn_move_s = positive(te, "c_turn_move", Dimension::Duration);
+  t.ring_radius_mm = te.positiveQuantity("ring_radius", Dimension::Length);
+  t.wait_s = te.positiveQuantity("wait", Dimension::Duration);
+  t.c_turn_move_s = te.positiveQuantity("c_turn_move", Dimension::Duration);
   int load_cycles = 0;
   for (auto& lm : te.mapList("load")) {
     TtpLoadPhase ph;
@@ -267,11 +261,11 @@ ThermalTestPiece loadThermalTestPiece(const std::string& path) {
 
   YamlMap in = root.map("inspection");
   YamlMap pr = in.map("probing");
-  t.probing.feed_mm_per_min = positive(pr, "feed", Dimension::Feed);
-  t.probing.positioning_feed_mm_per_min = positive(pr, "positioning_feed", Dimension::Feed);
-  t.probing.approach_mm = positive(pr, "approach", Dimension::Length);
-  t.probing.overtravel_mm = positive(pr, "overtravel", Dimension::Length);
-  t.probing.clearance_mm = positive(pr, "clearance", Dimension::Length);
+  t.probing.feed_mm_per_min = pr.positiveQuantity("feed", Dimension::Feed);
+  t.probing.positioning_feed_mm_per_min = pr.positiveQuantity("positioning_feed", Dimension::Feed);
+  t.probing.approach_mm = pr.positiveQuantity("approach", Dimension::Length);
+  t.probing.overtravel_mm = pr.positiveQuantity("overtravel", Dimension::Length);
+  t.probing.clearance_mm = pr.positiveQuantity("clearance", Dimension::Length);
   pr.finish();
   YamlMap fp = in.map("facet_points");
   t.facet_points_across_mm = lengths(fp, "across");
@@ -290,7 +284,7 @@ ThermalTestPiece loadThermalTestPiece(const std::string& path) {
     zpp.fail("along", "a plane needs points spread along and across the path (at least 2 x 2)");
   zpp.finish();
   YamlMap dc = in.map("datum_circle");
-  t.datum_band_diameter_mm = positive(dc, "band_diameter", Dimension::Length);
+  t.datum_band_diameter_mm = dc.positiveQuantity("band_diameter", Dimension::Length);
   t.datum_circle_z_mm = dc.quantity("z", Dimension::Length);
   t.datum_circle_points = dc.integer("points");
   {
@@ -316,7 +310,7 @@ ThermalTestPiece loadThermalTestPiece(const std::string& path) {
   YamlMap ev = root.map("evaluation");
   t.eq_7_10_alpha_um_per_m_K = ev.number("alpha_um_per_m_K");
   t.alpha_u_um_per_m_K = ev.number("alpha_u_um_per_m_K");
-  t.eq_7_10_radius_mm = positive(ev, "radius", Dimension::Length);
+  t.eq_7_10_radius_mm = ev.positiveQuantity("radius", Dimension::Length);
   if (!(t.eq_7_10_alpha_um_per_m_K > 0)) ev.fail("alpha_um_per_m_K", "must be positive");
   if (t.alpha_u_um_per_m_K < 0) ev.fail("alpha_u_um_per_m_K", "must not be negative");
   ev.finish();

@@ -15,6 +15,7 @@
 #include "core/units.hpp"
 #include "parts/plan_manifest.hpp"
 #include "parts/test_piece.hpp"
+#include "parts/test_support.hpp"
 #include "parts/thermal_test_piece.hpp"
 
 namespace probeloop::parts {
@@ -24,22 +25,7 @@ namespace fs = std::filesystem;
 
 std::string shipped() { return std::string(PROBELOOP_SOURCE_DIR) + "/parts/thermal_test_piece.yaml"; }
 
-std::string readAll(const std::string& p) {
-  std::ifstream in(p);
-  return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-// The shipped file with one text replaced, in a fresh temporary file.
-std::string variant(const std::string& from, const std::string& to) {
-  std::string s = readAll(shipped());
-  const auto at = s.find(from);
-  if (at == std::string::npos) throw std::logic_error("no '" + from + "' in the shipped file");
-  s.replace(at, from.size(), to);
-  static int n = 0;
-  const auto p = fs::temp_directory_path() / ("probeloop-ttp-" + std::to_string(::getpid()) + "-" + std::to_string(n++) + ".yaml");
-  std::ofstream(p) << s;
-  return p.string();
-}
+std::string variant(const std::string& from, const std::string& to) { return test::variantOf(shipped(), from, to); }
 
 std::string refusal(const std::string& file) {
   try {

@@ -51,6 +51,12 @@ YAML::Node YamlMap::node(const std::string& key) {
   return n;
 }
 
+double YamlMap::positiveQuantity(const std::string& key, Dimension dim) {
+  const double v = quantity(key, dim);
+  if (!(v > 0)) fail(key, "must be positive");
+  return v;
+}
+
 double YamlMap::quantity(const std::string& key, Dimension dim) {
   const YAML::Node n = node(key);
   if (!n.IsScalar()) fail(key, std::string("expected ") + acceptedUnits(dim));

@@ -22,6 +22,7 @@ class YamlMap {
   bool has(const std::string& key) const;
   double quantity(const std::string& key, Dimension dim);
   double quantityOr(const std::string& key, Dimension dim, double fallback);
+  double positiveQuantity(const std::string& key, Dimension dim);  // > 0, else "must be positive"
   std::vector<double> quantityList(const std::string& key, Dimension dim);
   double number(const std::string& key);  // a plain finite number (unit in the key's name)
   double numberOr(const std::string& key, double fallback);
