@@ -40,12 +40,12 @@ std::string join(const std::string& dir, const std::string& file) {
 }
 
 int cmdPlan(const std::string& piece_file, const std::string& machine_file, const std::string& out_dir,
-            const std::string& dialect_opt) {
+            const std::string& dialect_opt, const std::string& experiment) {
   const auto piece = parts::loadTestPiece(piece_file);
   const auto machine = parts::loadMachine(machine_file);
   const bool linux = dialect_opt == "linuxcnc" || (dialect_opt == "machine" && machine.dialect == parts::Dialect::LinuxCnc);
   const auto plan = planner::planTestPiece(piece, machine, linux ? parts::Dialect::LinuxCnc : parts::Dialect::FanucMacroB,
-                                           out_dir);
+                                           out_dir, experiment);
   // Everything is planned and checked before the first file is written.
   for (const auto& p : plan.programs) writeFileAtomic(join(out_dir, p.file), p.text);
   for (const auto& [name, content] : plan.files) writeFileAtomic(join(out_dir, name), content);
@@ -238,19 +238,20 @@ int main(int argc, char** argv) {
   CLI::App app{"probeloop: plan, simulate and evaluate touch-probe cycles for machine-tool metrology"};
   app.require_subcommand(1);
 
-  std::string artifact, machine, out = ".", dialect = "machine", manifest, truth, points,
+  std::string artifact, machine, out = ".", dialect = "machine", experiment, manifest, truth, points,
               format = "auto", scene;
   double step_um = 1.0, gauge_resolution_um = 1.0;
   std::optional<double> exaggeration;
   std::uint64_t seed = 1;
   bool free_radius = false;
 
-  auto* plan = app.add_subcommand("plan", "Programs (G-code) and the plan manifest for a test piece: sphere artifact, thermal test piece");
-  plan->add_option("piece", artifact, "test-piece description (YAML, kind: sphere_artifact | thermal_test_piece)")->required()->check(CLI::ExistingFile);
+  auto* plan = app.add_subcommand("plan", "Programs (G-code) and the plan manifest for a test piece: sphere artifact, thermal test piece, stepped workpiece");
+  plan->add_option("piece", artifact, "test-piece description (YAML, kind: sphere_artifact | thermal_test_piece | stepped_workpiece)")->required()->check(CLI::ExistingFile);
   plan->add_option("--machine", machine, "machine description (YAML)")->required()->check(CLI::ExistingFile);
   plan->add_option("--out", out, "output folder")->capture_default_str();
   plan->add_option("--dialect", dialect, "machine (from the machine file), linuxcnc or fanuc")
       ->check(CLI::IsMember({"machine", "linuxcnc", "fanuc"}))->capture_default_str();
+  plan->add_option("--experiment", experiment, "stepped workpiece: the experiment to plan (W1 ... W8, Table 4.1)");
 
   auto* res = app.add_subcommand("resolution", "Resolution of the location errors (seed 004 Table 5.4)");
   res->add_option("artifact", artifact, "sphere artifact description (YAML)")->required()->check(CLI::ExistingFile);
@@ -338,7 +339,7 @@ int main(int argc, char** argv) {
   try {
     if (*model_group) return run_model();
     if (*report_group) return run_report();
-    if (*plan) return cmdPlan(artifact, machine, out, dialect);
+    if (*plan) return cmdPlan(artifact, machine, out, dialect, experiment);
     if (*res) return cmdResolution(artifact, machine, step_um);
     if (*syn) return cmdSynth(manifest, truth, out, seed);
     if (*simc) return cmdSimulate(sim_programs, machine, part, truth, out, seed, cmm_points, sim_trace);

@@ -62,6 +62,7 @@ struct Program {
   int number = 1000;                // Fanuc O-number
   int work_offset = 6;              // 1..6 = G54..G59, zeroed by the program
   bool has_b_axis = false;
+  bool has_c_axis = true;  // false: a 3-axis machine (no C word in the work offset)
   // Programs that probe: LinuxCNC LOGOPEN name (Fanuc writes to its DPRNT device); the log's
   // cycle number is 1. Empty: the program opens no log and must not probe.
   std::string log_file;

@@ -52,7 +52,7 @@ std::string clean(std::string s) {
   return s;
 }
 
-std::string offsetAxes(bool b) { return b ? " X0 Y0 Z0 B0 C0" : " X0 Y0 Z0 C0"; }
+std::string offsetAxes(bool b, bool c = true) { return std::string(" X0 Y0 Z0") + (b ? " B0" : "") + (c ? " C0" : ""); }
 
 const char* wcs(int n) {
   static const char* names[] = {"G54", "G55", "G56", "G57", "G58", "G59"};
@@ -239,7 +239,7 @@ std::string writeLinuxCnc(const Program& p) {
   o << "(" << clean(p.title) << ")\n";
   for (const auto& h : p.header) o << "(" << clean(h) << ")\n";
   o << "G21 G90 G17 G40 G49 G80 G94\n";
-  o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_b_axis) << "\n";
+  o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_b_axis, p.has_c_axis) << "\n";
   o << wcs(p.work_offset) << "\n";
   if (!p.log_file.empty()) {
     o << "(LOGOPEN," << p.log_file << ")\n";
@@ -259,7 +259,7 @@ std::string writeFanucMacroB(const Program& p) {
   o << "O" << p.number << " (" << FanucWriter::upper(clean(p.title)) << ")\n";
   for (const auto& h : p.header) o << "(" << FanucWriter::upper(clean(h)) << ")\n";
   o << "G21 G90 G17 G40 G49 G80 G94\n";
-  o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_b_axis) << "\n";
+  o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_b_axis, p.has_c_axis) << "\n";
   o << wcs(p.work_offset) << "\n";
   if (!p.log_file.empty()) {
     o << "POPEN\n";

@@ -118,6 +118,24 @@ std::string genericManifestJson(const PlanManifest& m) {
                                                {"temperature_change_K", t.on_machine_temperature_change_K}}},
                                {"cmm_plan", t.cmm_plan}};
   }
+  if (m.kind == "stepped_workpiece") {
+    const auto& t = m.sw;
+    ordered_json steps = ordered_json::array();
+    for (const auto& s : t.steps)
+      steps.push_back({{"step", s.step}, {"feed_xy_mm_per_min", s.feed_xy_mm_per_min}, {"feed_z_mm_per_min", s.feed_z_mm_per_min},
+                       {"spindle_speed_rpm", s.spindle_speed_rpm}, {"start_s", s.start_s}, {"end_s", s.end_s},
+                       {"temp_state_min", s.temp_state_min}});
+    j["stepped_workpiece"] = {{"experiment", t.experiment},
+                              {"transition", t.transition},
+                              {"transition_feed_mm_per_min", t.transition_feed_mm_per_min},
+                              {"tool_runout_mm", t.tool_runout_mm},
+                              {"sizes_mm", t.sizes_mm},
+                              {"steps", steps},
+                              {"cmm", {{"mpe_constant_um", t.cmm.mpe_constant_um},
+                                       {"mpe_length_mm", t.cmm.mpe_length_mm},
+                                       {"temperature_half_width_K", t.cmm.temperature_half_width_K}}},
+                              {"cmm_plan", t.cmm_plan}};
+  }
   j["features"] = ordered_json::array();
   for (const auto& f : m.features) {
     const auto& n = f.nominal;
@@ -239,6 +257,34 @@ void readGeneric(const ordered_json& j, PlanManifest& m) {
          "cmm: MPE terms and the temperature half-width must not be negative");
     need(c.on_machine_repeatability_um >= 0 && c.on_machine_temperature_change_K >= 0,
          "on_machine: repeatability and temperature change must not be negative");
+  }
+  if (m.kind == "stepped_workpiece") {
+    const auto& t = j.at("stepped_workpiece");
+    auto& c = m.sw;
+    c.experiment = t.at("experiment");
+    c.transition = t.at("transition");
+    c.transition_feed_mm_per_min = t.at("transition_feed_mm_per_min");
+    c.tool_runout_mm = t.at("tool_runout_mm");
+    c.sizes_mm = t.at("sizes_mm").get<std::vector<double>>();
+    for (const auto& s : t.at("steps")) {
+      ManifestStep x;
+      x.step = s.at("step");
+      x.feed_xy_mm_per_min = s.at("feed_xy_mm_per_min");
+      x.feed_z_mm_per_min = s.at("feed_z_mm_per_min");
+      x.spindle_speed_rpm = s.at("spindle_speed_rpm");
+      x.start_s = s.at("start_s");
+      x.end_s = s.at("end_s");
+      x.temp_state_min = s.at("temp_state_min");
+      c.steps.push_back(x);
+    }
+    c.cmm.mpe_constant_um = t.at("cmm").at("mpe_constant_um");
+    c.cmm.mpe_length_mm = t.at("cmm").at("mpe_length_mm");
+    c.cmm.temperature_half_width_K = t.at("cmm").at("temperature_half_width_K");
+    c.cmm_plan = t.at("cmm_plan");
+    if (c.steps.size() != c.sizes_mm.size() || c.steps.size() < 2)
+      throw InputError(path, 0, "stepped_workpiece.steps: expected one entry per size in sizes_mm (at least 2)");
+    for (double v : c.sizes_mm)
+      if (!(v > 0)) throw InputError(path, 0, "stepped_workpiece.sizes_mm: every size must be positive");
   }
   for (const auto& f : j.at("features")) {
     ManifestFeature x;

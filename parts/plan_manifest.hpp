@@ -79,6 +79,25 @@ struct ThermalTestPieceConstants {
   std::string cmm_plan;  // the CMM point plan written beside the manifest
 };
 
+// One step of a stepped-workpiece experiment: its cutting conditions (Table 4.1) and when it
+// was cut on the planned clock; temp_state_min is the thesis's 'Temp state' T (the mid-time of
+// the step's wall cuts from the start of step 1's first cut, min).
+struct ManifestStep {
+  int step = 0;
+  double feed_xy_mm_per_min = 0, feed_z_mm_per_min = 0, spindle_speed_rpm = 0;
+  double start_s = 0, end_s = 0, temp_state_min = 0;
+};
+
+// What the stepped-workpiece evaluation needs beyond the features (seed 000).
+struct SteppedWorkpieceConstants {
+  std::string experiment, transition;
+  double transition_feed_mm_per_min = 0, tool_runout_mm = 0;
+  std::vector<double> sizes_mm;
+  std::vector<ManifestStep> steps;
+  CmmSpec cmm;
+  std::string cmm_plan;
+};
+
 struct PlanManifest {
   std::string file;
   std::string kind = "sphere_artifact";
@@ -121,6 +140,7 @@ struct PlanManifest {
   std::vector<ManifestCut> cuts;
   std::vector<EvaluationRule> evaluation;
   ThermalTestPieceConstants ttp;
+  SteppedWorkpieceConstants sw;
 
   const ManifestSphere* sphere(int position) const;
   const ManifestFeature* feature(const std::string& id) const;  // nullptr if absent

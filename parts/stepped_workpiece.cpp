@@ -25,7 +25,11 @@ std::vector<double> SteppedWorkpiece::sizesFor(const SwExperiment& e) const {
   return out;
 }
 
-namespace {
+const CuttingTool& SteppedWorkpiece::finishingTool() const {
+  for (const auto& t : tools)
+    if (t.number == finishing_tool) return t;
+  throw std::logic_error("stepped workpiece: finishing tool T" + std::to_string(finishing_tool) + " not in the tools list");
+}
 
 // Near the blank's corners, `inset` in from both edges.
 std::vector<Vector2d> clampHoleCentres(const SteppedWorkpiece& w) {
@@ -35,6 +39,16 @@ std::vector<Vector2d> clampHoleCentres(const SteppedWorkpiece& w) {
     out.emplace_back(c + ((i == 0 || i == 3) ? corner : -corner), c + (i < 2 ? corner : -corner));
   return out;
 }
+
+Vector3d steppedWorkpieceOrigin(const SteppedWorkpiece& w, const Machine& m) {
+  Vector2d xy(0.5 * (m.x.min_mm + m.x.max_mm), 0.5 * (m.y.min_mm + m.y.max_mm));
+  if (m.c.present) xy = m.c_axis_centre_mm;
+  const double c = w.centreXY();
+  return Vector3d(xy.x() - c, xy.y() - c,
+                  m.table_surface_z_mm + w.fixture_height_mm + w.blank_height_mm - w.blankTopZ());
+}
+
+namespace {
 
 // Sizes that grow from the top step down and leave a wall on every side of the next step
 // (a step no larger than the one above it would have no floor to probe).
@@ -115,6 +129,16 @@ SteppedWorkpiece loadSteppedWorkpiece(const std::string& path) {
   YamlMap fx = root.map("fixture");
   w.fixture_diameter_mm = fx.positiveQuantity("diameter", Dimension::Length);
   w.fixture_height_mm = fx.positiveQuantity("height", Dimension::Length);
+  // The blank is bolted through its clamp holes into the fixture's threaded holes (L719).
+  if (w.clamp_holes) {
+    const double r = std::hypot(std::min(w.blank_x_mm, w.blank_y_mm) / 2 - w.clamp_hole_inset_mm,
+                                std::min(w.blank_x_mm, w.blank_y_mm) / 2 - w.clamp_hole_inset_mm) +
+                     w.clamp_hole_diameter_mm / 2;
+    if (!(r <= w.fixture_diameter_mm / 2))
+      fx.fail("diameter", formatNumber(w.fixture_diameter_mm) + " mm: the clamp holes reach " + formatNumber(r, 2) +
+                              " mm from the centre, beyond the fixture, whose threaded holes they bolt into (needs at least " +
+                              formatNumber(2 * r, 2) + " mm)");
+  }
   fx.finish();
 
   w.tools = readCuttingTools(root, "tools");
@@ -192,7 +216,37 @@ SteppedWorkpiece loadSteppedWorkpiece(const std::string& path) {
   w.probing.overtravel_mm = pb.positiveQuantity("overtravel", Dimension::Length);
   w.probing.clearance_mm = pb.positiveQuantity("clearance", Dimension::Length);
   w.probing.repeatability_mm = pb.positiveQuantity("repeatability", Dimension::Length);
+  w.probing.step3_wall_passes = pb.has("step3_wall_passes") ? pb.integer("step3_wall_passes") : 1;
+  if (!(w.probing.step3_wall_passes >= 1 && w.probing.step3_wall_passes <= 10))
+    pb.fail("step3_wall_passes", "expected 1 (no repeat) to 10");
+  if (w.probing.step3_wall_passes > 1 && w.steps.size() < 3) pb.fail("step3_wall_passes", "the piece has no step 3");
   pb.finish();
+
+  YamlMap mc = root.map("machining");
+  {
+    YamlMap r = mc.map("roughing");
+    auto& g = w.machining;
+    g.roughing_spindle_rpm = r.positiveQuantity("spindle_speed", Dimension::RotSpeed);
+    g.roughing_feed_xy_mm_per_min = r.positiveQuantity("feed_xy", Dimension::Feed);
+    g.roughing_feed_z_mm_per_min = r.positiveQuantity("feed_z", Dimension::Feed);
+    g.roughing_depth_per_level_mm = r.positiveQuantity("depth_per_level", Dimension::Length);
+    if (!(g.roughing_depth_per_level_mm <= tool->flute_length_mm))
+      r.fail("depth_per_level", formatNumber(g.roughing_depth_per_level_mm) + " mm is deeper than the flutes of T" +
+                                    std::to_string(tool->number) + " (" + formatNumber(tool->flute_length_mm) + " mm)");
+    r.finish();
+    g.stepover = mc.number("stepover");
+    if (!(g.stepover > 0.05 && g.stepover <= 0.9)) mc.fail("stepover", "expected a fraction of the tool's diameter, 0.05 to 0.9");
+    g.lead_mm = mc.positiveQuantity("lead", Dimension::Length);
+    g.clearance_mm = mc.positiveQuantity("clearance", Dimension::Length);
+  }
+  mc.finish();
+  // One finishing pass cuts a wall over its whole height (and the margin above it).
+  for (std::size_t k = 0; k < w.steps.size(); ++k) {
+    const double h = w.steps[k].floor_depth_mm - (k ? w.steps[k - 1].floor_depth_mm : 0.0) + w.finishing_margin_mm;
+    if (!(h <= tool->flute_length_mm))
+      root.fail("steps", "step " + std::to_string(k + 1) + ": its wall (" + formatNumber(h) + " mm with the margin) is taller than the flutes of the finishing tool T" +
+                             std::to_string(tool->number) + " (" + formatNumber(tool->flute_length_mm) + " mm), which finish a wall in one pass");
+  }
   w.cmm = readCmm(root.map("cmm"));
   root.finish();
   // Every layout must fit every size set the experiments cut (the shipped and the W2/W5 one).
@@ -318,16 +372,15 @@ Workpiece steppedWorkpieceStock(const SteppedWorkpiece& w) {
   s.file = w.file;
   s.name = w.name;
   const double c = w.centreXY();
-  // The blank before roughing: its top face is the finished top plus nothing (the top is
-  // faced at z 0 in the first operation, L739); the finishing margin lives in the roughing
-  // program, not in the blank.
-  s.stock_min_mm = Vector3d(c - w.blank_x_mm / 2, c - w.blank_y_mm / 2, -w.blank_height_mm);
-  s.stock_max_mm = Vector3d(c + w.blank_x_mm / 2, c + w.blank_y_mm / 2, 0);
+  // The blank before roughing, faced on both sides (L695-700): its top stands the finishing
+  // margin above the finished top, which finishing faces at z 0 with step 1 (L739).
+  const double top = w.blankTopZ(), bottom = top - w.blank_height_mm;
+  s.stock_min_mm = Vector3d(c - w.blank_x_mm / 2, c - w.blank_y_mm / 2, bottom);
+  s.stock_max_mm = Vector3d(c + w.blank_x_mm / 2, c + w.blank_y_mm / 2, top);
   int i = 0;
   for (const auto& h : clampHoleCentres(w))
-    s.holes.push_back({h, w.clamp_hole_diameter_mm / 2, -w.blank_height_mm - 1, 1, "clamp hole " + std::to_string(++i)});
-  s.obstacles.push_back({Vector2d(c, c), w.fixture_diameter_mm / 2, -w.blank_height_mm - w.fixture_height_mm, -w.blank_height_mm,
-                         "fixture"});
+    s.holes.push_back({h, w.clamp_hole_diameter_mm / 2, bottom - 1, top + 1, "clamp hole " + std::to_string(++i)});
+  s.obstacles.push_back({Vector2d(c, c), w.fixture_diameter_mm / 2, bottom - w.fixture_height_mm, bottom, "fixture"});
   s.material = w.material;
   s.tools = w.tools;
   s.cmm = w.cmm;

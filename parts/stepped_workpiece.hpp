@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "parts/feature.hpp"
+#include "parts/machine.hpp"
 #include "parts/workpiece.hpp"
 
 namespace probeloop::parts {
@@ -63,6 +64,21 @@ struct SwProbing {
   double feed_mm_per_min = 0, positioning_feed_mm_per_min = 0;
   double approach_mm = 0, overtravel_mm = 0, clearance_mm = 0;
   double repeatability_mm = 0;         // +-2 um on W8 step 3 (L769), read as 2 sigma
+  // Step 3's wall points are probed this many times in all (L769: the repeatability came from
+  // random repeats on W8 step 3): 1 = no repeat.
+  int step3_wall_passes = 1;
+};
+
+// How the programs cut (the thesis gives none of it, notes §2.2: our choices, stated in
+// docs/stepped-workpiece.md): roughing from the blank to the finishing margin, the stepover
+// of roughing contours and floor passes, the lead past a wall's roughed end before a
+// non-cutting transition, the clearance plane above the blank.
+struct SwMachining {
+  double roughing_spindle_rpm = 0, roughing_feed_xy_mm_per_min = 0, roughing_feed_z_mm_per_min = 0;
+  double roughing_depth_per_level_mm = 0;
+  double stepover = 0;  // of the tool's diameter
+  double lead_mm = 0;
+  double clearance_mm = 0;
 };
 
 // One planned contact on a face: the nominal point on the face, the outward normal (the probe
@@ -98,12 +114,17 @@ struct SteppedWorkpiece {
   bool warm_up_axis_manoeuvre = false; // L739-741
   std::vector<SwExperiment> experiments;
   SwProbing probing;
+  SwMachining machining;
   CmmSpec cmm;
 
   const SwExperiment* experiment(const std::string& id) const;
   // The step sizes an experiment cuts (the standard set or the alternative one).
   std::vector<double> sizesFor(const SwExperiment& e) const;
   double centreXY() const { return steps.front().size_mm / 2; }
+  // The blank's top in the part frame: the top face plus the finishing margin (roughing leaves
+  // the margin on every face, the top included, L695; finishing faces the top at z 0).
+  double blankTopZ() const { return finishing_margin_mm; }
+  const CuttingTool& finishingTool() const;
 };
 
 SteppedWorkpiece loadSteppedWorkpiece(const std::string& path);
@@ -122,5 +143,14 @@ std::vector<SwProbePoint> probePoints(const SteppedWorkpiece& w, const std::vect
 // The blank on its fixture as the simulator machines it: a box centred on (c, c) from the top
 // face down, clamp holes through it, the fixture below as a collision body.
 Workpiece steppedWorkpieceStock(const SteppedWorkpiece& w);
+
+// The part frame's origin in machine (tip) coordinates: the steps' centre over the middle of
+// the X/Y travel ("position errors at the centre of the worktable", L2030), the blank on its
+// fixture on the table surface (the C axis's centre and table on a machine with a rotary
+// table, left at C = 0).
+Eigen::Vector3d steppedWorkpieceOrigin(const SteppedWorkpiece& w, const Machine& m);
+
+// Centres of the clamp holes (part frame), near the blank's corners.
+std::vector<Eigen::Vector2d> clampHoleCentres(const SteppedWorkpiece& w);
 
 }  // namespace probeloop::parts

@@ -157,9 +157,10 @@ TEST(SteppedWorkpiece, TheStockIsTheBlankOnItsFixture) {
   EXPECT_EQ(piece.features.size(), 21u);
   ASSERT_TRUE(piece.stock);
   const auto& s = *piece.stock;
-  // 150 x 150 x 50 mm centred on the steps' centre (15, 15), its top the part's top face.
-  EXPECT_EQ(s.stock_min_mm, Vector3d(-60, -60, -50));
-  EXPECT_EQ(s.stock_max_mm, Vector3d(90, 90, 0));
+  // 150 x 150 x 50 mm centred on the steps' centre (15, 15), its top the finishing margin
+  // (0.5 mm) above the part's top face.
+  EXPECT_EQ(s.stock_min_mm, Vector3d(-60, -60, -49.5));
+  EXPECT_EQ(s.stock_max_mm, Vector3d(90, 90, 0.5));
   ASSERT_EQ(s.holes.size(), 4u);
   for (const auto& h : s.holes) {
     // 10 mm in from the corners, clear of the largest step's tool path (49.5 + 10 mm).
@@ -169,7 +170,7 @@ TEST(SteppedWorkpiece, TheStockIsTheBlankOnItsFixture) {
   }
   ASSERT_EQ(s.obstacles.size(), 1u);
   EXPECT_EQ(s.obstacles[0].name, "fixture");
-  EXPECT_DOUBLE_EQ(s.obstacles[0].z_max_mm, -50);
+  EXPECT_DOUBLE_EQ(s.obstacles[0].z_max_mm, -49.5);
   EXPECT_THROW(expansionLevers(piece), InputError);  // no evaluation yet
 }
 
@@ -245,6 +246,14 @@ TEST(SteppedWorkpiece, BadDescriptionsAreRefusedWithTheLine) {
   expectRefused(variant("inset: 10 mm", "inset: 2 mm"), "inset: a hole 2 mm in from the edges would break out of the blank");
   // 15 mm in: 60 mm from the centre, inside the largest step's path (49.5 + 10 + 4.5 = 64).
   expectRefused(variant("inset: 10 mm", "inset: 15 mm"), "the clamp holes at 60 mm from the centre");
+  // The holes 65 mm from the centre along X and Y (91.92 mm away) with their 4.5 mm radius
+  // reach 96.42 mm: they bolt into nothing on a 160 mm fixture.
+  expectRefused(variant("diameter: 200 mm", "diameter: 160 mm"), "fixture.diameter: 160 mm: the clamp holes reach 96.42 mm");
+  // Finishing cuts a wall in one pass: step 2's 10 mm wall + 0.5 mm margin needs 10.5 mm of flute.
+  expectRefused(variant("flute_length: 22 mm", "flute_length: 10 mm"), "step 2: its wall (10.5 mm with the margin) is taller than the flutes");
+  expectRefused(variant("depth_per_level: 5 mm", "depth_per_level: 30 mm"), "depth_per_level: 30 mm is deeper than the flutes of T1 (22 mm)");
+  expectRefused(variant("stepover: 0.75", "stepover: 1.2"), "stepover: expected a fraction of the tool's diameter");
+  expectRefused(variant("step3_wall_passes: 2", "step3_wall_passes: 0"), "step3_wall_passes: expected 1 (no repeat) to 10");
 }
 
 }  // namespace

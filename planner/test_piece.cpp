@@ -9,6 +9,7 @@
 #include "core/csv.hpp"
 #include "core/error.hpp"
 #include "planner/sphere_cycle.hpp"
+#include "planner/stepped_workpiece.hpp"
 #include "planner/thermal_test_piece.hpp"
 
 namespace probeloop::planner {
@@ -151,16 +152,87 @@ TestPiecePlan thermal(const parts::TestPiece& piece, const parts::ThermalTestPie
   return out;
 }
 
+std::string hm(double s) {
+  const long t = std::lround(s);
+  char b[32];
+  std::snprintf(b, sizeof b, "%ld:%02ld", t / 3600, (t / 60) % 60);
+  return b;
+}
+
+TestPiecePlan stepped(const parts::SteppedWorkpiece& w, const std::string& experiment, const parts::Machine& m,
+                      parts::Dialect dialect, const std::string& out_dir) {
+  if (experiment.empty()) {
+    std::string ids;
+    for (const auto& e : w.experiments) ids += (ids.empty() ? "" : ", ") + e.id;
+    throw InputError(w.file, 0, "kind: stepped_workpiece: choose the experiment to plan with --experiment (one of " + ids + ")");
+  }
+  auto plan = planSteppedWorkpiece(w, experiment, m, dialect);
+  TestPiecePlan out;
+  for (std::size_t i = 0; i < plan.programs.size(); ++i) {
+    PlannedProgram p;
+    p.role = plan.programs[i].role;
+    p.file = plan.programs[i].file;
+    p.text = swProgramText(plan.programs[i], dialect);
+    p.start_s = plan.start_s[i];
+    p.duration_s = plan.duration_s[i];
+    out.programs.push_back(p);
+  }
+  const auto& man = plan.manifest;
+  out.files.emplace_back(man.sw.cmm_plan, plan.cmm_points_csv);
+  const auto* e = w.experiment(experiment);
+  std::ostringstream s;
+  std::string sizes;
+  for (double v : plan.sizes_mm) sizes += (sizes.empty() ? "" : "/") + formatNumber(v);
+  s << "Planned experiment " << e->id << " on the stepped workpiece (seed 000 Table 4.1) for " << m.name << " ("
+    << parts::dialectName(dialect) << " dialect): steps " << sizes << " mm, transition " << e->transition;
+  if (e->transition != "continuous") s << " at " << formatNumber(e->transition_feed_mm_per_min) << " mm/min";
+  s << "\n";
+  const char* waits[3] = {"", " after the machine is off for ", " after the cool-down of "};
+  const double wait_s[3] = {0, w.off_before_s, w.off_after_s};
+  for (std::size_t i = 0; i < out.programs.size(); ++i) {
+    const auto& p = out.programs[i];
+    s << "  " << p.file << std::string(p.file.size() < 14 ? 14 - p.file.size() : 1, ' ')
+      << (dialect == parts::Dialect::FanucMacroB ? "O" + std::to_string(plan.programs[i].program.number) + "  " : std::string())
+      << "starts " << hms(p.start_s) << waits[i] << (i ? hm(wait_s[i]) : std::string()) << ", runs " << hms(p.duration_s)
+      << " (" << formatNumber(p.duration_s, 1) << " s)";
+    if (p.role == "probing") s << ": " << man.points.size() << " probed points, log " << plan.programs[i].program.log_file;
+    s << "\n";
+    const auto& t = plan.times[i];
+    const std::pair<const char*, double> parts[] = {{"feeds", t.feed_s},         {"rapids", t.rapid_s},
+                                                    {"tool changes", t.tool_change_s}, {"protected moves", t.protected_s},
+                                                    {"probing", t.probing_s},   {"dwells", t.dwell_s}};
+    std::string sep = "    ";
+    for (const auto& [name, v] : parts)
+      if (v > 0.05) {
+        s << sep << name << " " << formatNumber(v, 1) << " s";
+        sep = ", ";
+      }
+    s << "\n";
+  }
+  s << "Steps (Temp state T = mid-time of the step's wall cuts from the start of step 1, min):\n";
+  for (const auto& st : plan.steps)
+    s << "  step " << st.step << ": feed XY " << formatNumber(st.conditions.feed_xy_mm_per_min) << " / Z "
+      << formatNumber(st.conditions.feed_z_mm_per_min) << " mm/min, " << formatNumber(st.conditions.spindle_speed_rpm)
+      << " rpm, cut " << hms(st.start_s) << " - " << hms(st.end_s) << ", T = " << formatNumber(st.temp_state_min, 2) << " min\n";
+  s << "  wrote";
+  for (const auto& p : out.programs) s << " " << join(out_dir, p.file) << ",";
+  s << " " << join(out_dir, man.sw.cmm_plan) << " and " << join(out_dir, "plan.json") << "\n";
+  s << "  (planned with the simulator's clock, no acceleration: docs/simulator.md §2, docs/stepped-workpiece.md §4)\n";
+  out.summary = s.str();
+  out.manifest = std::move(plan.manifest);
+  return out;
+}
+
 }  // namespace
 
 TestPiecePlan planTestPiece(const parts::TestPiece& piece, const parts::Machine& machine, parts::Dialect dialect,
-                            const std::string& out_dir) {
+                            const std::string& out_dir, const std::string& experiment) {
+  if (const auto* w = piece.steppedWorkpiece()) return stepped(*w, experiment, machine, dialect, out_dir);
+  if (!experiment.empty())
+    throw InputError(piece.file, 0, "--experiment " + experiment + ": only a stepped workpiece has experiments (this is kind: " +
+                                        piece.kind + ")");
   if (const auto* a = piece.sphereArtifact()) return sphere(*a, machine, dialect, out_dir);
   if (const auto* t = piece.thermalTestPiece()) return thermal(piece, *t, machine, dialect, out_dir);
-  if (piece.steppedWorkpiece())
-    throw InputError(piece.file, 0,
-                     "kind: stepped_workpiece has no planner yet (issue 14: the W1-W8 programs come next); its description, "
-                     "features and stock load and are checked");
   if (piece.kind == "workpiece")
     throw InputError(piece.file, 0,
                      "a plain workpiece has no planner: write its program yourself and run it with probeloop simulate");

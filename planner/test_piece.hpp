@@ -5,7 +5,9 @@
 // Contract: sphere_artifact -> the sphere cycle (planner/sphere_cycle.hpp), byte for byte
 // what planSphereCycle + programText give; thermal_test_piece -> planner/thermal_test_piece.hpp
 // with the piece's own `features` and `evaluation` (into the manifest as they are);
-// workpiece -> InputError (a plain workpiece has no planner). Nothing is written here: the
+// stepped_workpiece -> planner/stepped_workpiece.hpp for `experiment` (required: one of the
+// description's W1..W8; InputError listing them when empty or unknown, and for any other kind
+// when given); workpiece -> InputError (a plain workpiece has no planner). Nothing is written here: the
 // caller writes programs[].text to programs[].file, files[] and plan.json
 // (parts::manifestToJson(manifest)) into one folder. `out_dir` only names that folder in the
 // summary's "wrote" line.
@@ -33,6 +35,6 @@ struct TestPiecePlan {
 };
 
 TestPiecePlan planTestPiece(const parts::TestPiece& piece, const parts::Machine& machine, parts::Dialect dialect,
-                            const std::string& out_dir = "");
+                            const std::string& out_dir = "", const std::string& experiment = "");
 
 }  // namespace probeloop::planner

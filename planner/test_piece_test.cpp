@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 
 #include "core/error.hpp"
 #include "planner/sphere_cycle.hpp"
@@ -56,18 +57,42 @@ TEST(PlanTestPiece, APlainWorkpieceHasNoPlanner) {
 }
 
 // Issue 14 in progress: the description loads, planning says what is missing, nothing written.
-TEST(PlanTestPiece, TheSteppedWorkpieceHasNoPlannerYet) {
+// A stepped workpiece is planned one experiment at a time: without one the refusal lists them;
+// an experiment given for another kind is refused too; with W8 the three programs, the CMM plan
+// and a summary with each step's Temp state.
+TEST(PlanTestPiece, TheSteppedWorkpieceIsPlannedPerExperiment) {
   const auto piece = parts::loadTestPiece(src + "/parts/stepped_workpiece.yaml");
-  const auto out = std::filesystem::temp_directory_path() / "probeloop-sw-plan-never-written";
-  std::filesystem::remove_all(out);
-  try {
-    planTestPiece(piece, machine("vmc3"), parts::Dialect::LinuxCnc, out.string());
-    FAIL();
-  } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("stepped_workpiece.yaml: kind: stepped_workpiece has no planner yet"), std::string::npos)
-        << e.what();
-  }
-  EXPECT_FALSE(std::filesystem::exists(out));
+  auto refusal = [&](const parts::TestPiece& p, const std::string& e) {
+    try {
+      planTestPiece(p, machine("vmc3"), parts::Dialect::LinuxCnc, "out", e);
+    } catch (const InputError& x) {
+      return std::string(x.what());
+    }
+    return std::string("(planned)");
+  };
+  EXPECT_NE(refusal(piece, "").find("choose the experiment to plan with --experiment (one of W1, W2, W3, W4, W5, W6, W7, W8)"),
+            std::string::npos);
+  const auto ttp = parts::loadTestPiece(src + "/parts/thermal_test_piece.yaml");
+  EXPECT_NE(refusal(ttp, "W8").find("--experiment W8: only a stepped workpiece has experiments"), std::string::npos);
+  const auto plan = planTestPiece(piece, machine("vmc3"), parts::Dialect::FanucMacroB, "out", "W8");
+  ASSERT_EQ(plan.programs.size(), 3u);
+  EXPECT_EQ(plan.programs[0].file, "roughing.nc");
+  EXPECT_EQ(plan.programs[2].file, "probing.nc");
+  ASSERT_EQ(plan.files.size(), 1u);
+  EXPECT_EQ(plan.files[0].first, "cmm_points.csv");
+  EXPECT_EQ(plan.manifest.kind, "stepped_workpiece");
+  for (const char* s : {"Planned experiment W8", "O3002", "step 4: feed XY 800 / Z 800 mm/min, 3500 rpm", "T = "})
+    EXPECT_NE(plan.summary.find(s), std::string::npos) << s << "\n" << plan.summary;
+  // The manifest's stepped-workpiece block survives its JSON round trip.
+  const auto path = std::filesystem::temp_directory_path() / "probeloop-sw-plan.json";
+  std::ofstream(path) << parts::manifestToJson(plan.manifest);
+  const auto back = parts::readManifest(path.string());
+  EXPECT_EQ(back.sw.experiment, "W8");
+  ASSERT_EQ(back.sw.steps.size(), 4u);
+  EXPECT_DOUBLE_EQ(back.sw.steps[3].feed_xy_mm_per_min, 800);
+  EXPECT_DOUBLE_EQ(back.sw.steps[2].temp_state_min, plan.manifest.sw.steps[2].temp_state_min);
+  EXPECT_EQ(back.points.size(), plan.manifest.points.size());
+  std::filesystem::remove(path);
 }
 
 TEST(PlanTestPiece, TheThermalTestPieceGivesThreeProgramsTheCmmPlanAndASummary) {
