@@ -201,10 +201,12 @@ SteppedWorkpiece loadSteppedWorkpiece(const std::string& path) {
   YamlMap pb = root.map("probing");
   w.probing.wall_positions = pb.numberList("wall_positions");
   for (double f : w.probing.wall_positions)
-    if (!(f > -1 && f < 1)) pb.fail("wall_positions", "expected fractions of the wall's half length, strictly between -1 and 1");
+    if (!(f > -1 && f < 1))
+      pb.fail("wall_positions", formatNumber(f) + ": expected fractions of the wall's half length, strictly between -1 and 1");
   w.probing.wall_levels = pb.numberList("wall_levels");
   for (double f : w.probing.wall_levels)
-    if (!(f > 0 && f < 1)) pb.fail("wall_levels", "expected fractions of the wall's height below its top edge, strictly between 0 and 1");
+    if (!(f > 0 && f < 1))
+      pb.fail("wall_levels", formatNumber(f) + ": expected fractions of the wall's height below its top edge, strictly between 0 and 1");
   if (w.probing.wall_positions.size() * w.probing.wall_levels.size() < 3)
     pb.fail("wall_positions", "a wall's plane needs at least 3 points (positions x levels)");
   w.probing.top_grid = pb.number("top_grid");

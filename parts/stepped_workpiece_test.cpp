@@ -224,7 +224,8 @@ TEST(SteppedWorkpiece, ProbePointsFollowSection34) {
   // A 16 mm ball does not fit the 7.5 mm ring of step 1's floor.
   expectRefused(variant("tip_diameter: 2 mm", "tip_diameter: 16 mm"), "probing: ");
   expectRefused(variant("tip_diameter: 2 mm", "tip_diameter: 16 mm"), "lies within 8.5 mm (the ball's radius + 0.5 mm) of the face's edge");
-  expectRefused(variant("wall_positions: [-0.6, 0, 0.6]", "wall_positions: [-0.6, 0, 1.2]"), "strictly between -1 and 1");
+  expectRefused(variant("wall_positions: [-0.6, 0, 0.6]", "wall_positions: [-0.6, 0, 1.2]"), "wall_positions: 1.2: expected fractions of the wall's half length, strictly between -1 and 1");
+  expectRefused(variant("wall_levels: [0.2, 0.8]", "wall_levels: [0.2, 1.3]"), "wall_levels: 1.3: expected fractions");
   // 0.95 of the half length of the 30 mm step: 0.75 mm from its corner, within 1.5 mm.
   expectRefused(variant("wall_positions: [-0.6, 0, 0.6]", "wall_positions: [-0.95, 0, 0.6]"), "feature S1_XP: point 1 lies within 1.5 mm");
 }

@@ -182,6 +182,7 @@ class Builder {
     k.feature = feature;
     k.cycle = step;
     k.tool = tool_->number;
+    k.start_s = k.end_s = NAN;  // set by walk()
     k.from_mm = mach(from, z);
     k.to_mm = mach(to, z);
     man_.cuts.push_back(k);
@@ -298,7 +299,7 @@ class Builder {
     for (std::size_t j = 0; j < rings.size(); ++j) {
       const double s = rings[j];
       const int c = ci(gk + "_F-" + std::to_string(j + 1), gk + "_F", Vector2d(-s, s), Vector2d(-s, s));
-      if (j) feedXY(Vector2d(-s, s), F, w + ": floor, in to the next contour", !air, c);
+      if (j) feedXY(Vector2d(-s, s), F, w + ": floor, in to the next contour", !air);  // before the cut's from_mm
       contour(s, F, w + ": floor contour " + std::to_string(j + 1), c);
     }
     if (!air) material_.tops_finished = static_cast<int>(k) + 2;
@@ -557,9 +558,10 @@ class Builder {
         before[op] = a + offset;
         after[op] = b + offset;
         const auto& n = p.notes[op];
-        if (n.cut_index >= 0) {
-          man_.cuts[static_cast<std::size_t>(n.cut_index)].start_s = a + offset;
-          man_.cuts[static_cast<std::size_t>(n.cut_index)].end_s = b + offset;
+        if (n.cut_index >= 0) {  // a cut of several moves: from its first to its last
+          auto& c = man_.cuts[static_cast<std::size_t>(n.cut_index)];
+          if (std::isnan(c.start_s)) c.start_s = a + offset;
+          c.end_s = b + offset;
         }
         if (n.point_index >= 0) man_.points[static_cast<std::size_t>(n.point_index)].time_in_cycle_s = b - t0;
       });

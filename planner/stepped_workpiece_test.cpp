@@ -65,7 +65,13 @@ TEST(PlanSteppedWorkpiece, W8CutsEveryWallAtItsDepthAndFeed) {
     ASSERT_GE(k, 1);
     ASSERT_LE(k, 4);
     EXPECT_NEAR(c.to_mm.z(), O.z() - w.steps[k - 1].floor_depth_mm, 1e-9) << c.id;
-    if (c.feature.back() != 'F') {
+    if (c.feature.back() == 'F') {
+      // A floor contour: the closed square of half size s round the centre, 8 s long, timed
+      // from the tool leaving its corner to its return (not from its last side).
+      const double half = std::fabs(c.from_mm.x() - (O.x() + 15));
+      EXPECT_LT((c.to_mm - c.from_mm).norm(), 1e-9) << c.id;
+      EXPECT_NEAR(c.end_s - c.start_s, 8 * half / w.experiment("W8")->steps[k - 1].feed_xy_mm_per_min * 60, 1e-6) << c.id;
+    } else {
       ++walls[c.feature];
       // A wall is cut straight along it at the tool's radius from its face.
       const auto* f = plan.manifest.feature(c.feature);
