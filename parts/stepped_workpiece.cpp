@@ -386,6 +386,7 @@ Workpiece steppedWorkpieceStock(const SteppedWorkpiece& w) {
   s.material = w.material;
   s.tools = w.tools;
   s.cmm = w.cmm;
+  s.probe_tip_diameter_mm = w.probing.tip_diameter_mm;
   return s;
 }
 

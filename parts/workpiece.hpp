@@ -68,6 +68,9 @@ struct Workpiece {
   WorkpieceMaterial material;
   std::vector<CuttingTool> tools;
   CmmSpec cmm;
+  // The stylus ball the piece is probed with on the machine (the stepped workpiece's
+  // probing.tip_diameter); 0 = the machine file's probe tip.
+  double probe_tip_diameter_mm = 0;
   const CuttingTool* tool(int number) const;  // nullptr if not listed
   double blankRadius() const { return (stock_max_mm.x() - stock_min_mm.x()) / 2; }
   // The clamping datum: thermal expansion of the workpiece is about this point (part frame).

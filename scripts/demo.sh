@@ -120,14 +120,18 @@ eval "$cmd" > /dev/null
 probeloop model fit "$T/model.yaml" --report "$T/fit.html" > "$T/fit.txt"
 sed -n '/^Before -> after/,$p' "$T/fit.txt" | grep -E 'Before|channel|ETTP' | sed 's/^/   /'
 
-echo "== 8. the stepped workpiece (seed 000): the programs of experiment W8 and each step's Temp state =="
+echo "== 8. the stepped workpiece (seed 000): the programs of experiment W8, each step's Temp state, W8 on the virtual VMC =="
 S=$OUT/stepped
 $PL plan parts/stepped_workpiece.yaml --machine parts/machines/vmc3.yaml --out "$S/plan" --experiment W8 | sed 's/^/   /'
-echo "   (the simulation, the CMM and the error separation of the stepped workpiece come next: docs/stepped-workpiece.md)"
+$PL simulate "$S/plan/roughing.ngc" "$S/plan/finishing.ngc" "$S/plan/probing.ngc" --machine parts/machines/vmc3.yaml \
+  --part parts/stepped_workpiece.yaml --truth examples/truth_machining.yaml --cmm-points "$S/plan/cmm_points.csv" \
+  --out "$S/run" | sed 's/^/   /'
+echo "   (the error separation of the stepped workpiece comes next; the thesis's tables are reproduced by"
+echo "    evaluate/stepped_separation_test: docs/stepped-workpiece.md)"
 
 echo
 echo "Outputs: $OUT/plan (G-code, manifest), $OUT/run (controller log, points.csv, inputs.csv, truth.json),"
 echo "         $OUT/eval (errors.csv, evaluation.json, report.md, campaign.gltf), $OUT/machining (cuts.json, cmm_export.csv),"
 echo "         $OUT/campaign (72 h: model.yaml, diagnosis-*.html, fit-*.html with the plots),"
 echo "         $OUT/ttp (thermal test piece: plan/, run/, cmm/ and om/ evaluations, report.html, cmm/test_piece.gltf, r-test/, fit.html),"
-echo "         $OUT/stepped/plan (stepped workpiece W8: roughing, finishing, probing programs, cmm_points.csv, plan.json)"
+echo "         $OUT/stepped (stepped workpiece W8: plan/ with the roughing, finishing, probing programs; run/ with cmm_export.csv, sw_probe.log)"

@@ -609,7 +609,9 @@ class VirtualMachine : public gcode::MachineInterface {
 
   double currentToolLength() const { return toolLength(tool_); }
   double tipRadius() const {
-    if (tool_ == m_.probe.tool) return m_.probe.tip_diameter_mm / 2;
+    // A piece may name its own stylus (the stepped workpiece's d2 ball); else the machine's.
+    if (tool_ == m_.probe.tool)
+      return (w_ && w_->probe_tip_diameter_mm > 0 ? w_->probe_tip_diameter_mm : m_.probe.tip_diameter_mm) / 2;
     if (const auto* t = cutter()) return t->diameter_mm / 2;
     return 0.0;
   }
@@ -1197,10 +1199,12 @@ parts::Workpiece placeOnMachine(const parts::TestPiece& piece, const parts::Mach
     w.frame_origin_mm = parts::partOriginOnMachine(*t, machine.c_axis_centre_mm, machine.table_surface_z_mm);
     return w;
   }
-  if (piece.steppedWorkpiece())
-    throw InputError(piece.file, 0,
-                     "kind: stepped_workpiece cannot be placed on the virtual machine yet (issue 14: its fixture on the "
-                     "table, then the W1-W8 programs)");
+  if (const auto* sw = piece.steppedWorkpiece()) {
+    // The blank on its fixture on the table, the steps' centre where the planner put it.
+    parts::Workpiece w = *piece.stock;
+    w.frame_origin_mm = parts::steppedWorkpieceOrigin(*sw, machine);
+    return w;
+  }
   if (!piece.stock)
     throw InputError(piece.file, 0, "kind: " + piece.kind + " is not machined: it stands on the table as it is, not as a workpiece");
   return *piece.stock;
