@@ -6,6 +6,7 @@
 
 #include "core/csv.hpp"
 #include "core/error.hpp"
+#include "planner/piece_manifest.hpp"
 
 namespace probeloop::planner {
 
@@ -567,16 +568,7 @@ class Builder {
       });
       plan_.start_s.push_back(t0 + offset);
       plan_.duration_s.push_back(walker.time() - t0);
-      WalkTimes d = walker.times();
-      d.tool_change_s -= total.tool_change_s;
-      d.rapid_s -= total.rapid_s;
-      d.rotary_index_s -= total.rotary_index_s;
-      d.feed_s -= total.feed_s;
-      d.rotary_feed_s -= total.rotary_feed_s;
-      d.protected_s -= total.protected_s;
-      d.probing_s -= total.probing_s;
-      d.dwell_s -= total.dwell_s;
-      plan_.times.push_back(d);
+      plan_.times.push_back(walker.times() - total);
       total = walker.times();
       if (p.role == "finishing") {
         for (std::size_t k = 0; k < sizes_.size(); ++k) {
@@ -610,26 +602,11 @@ class Builder {
     auto& m = man_;
     m.kind = "stepped_workpiece";
     m.dialect = parts::dialectName(dialect_);
-    for (std::size_t i = 0; i < programs_.size(); ++i) {
-      parts::ManifestProgram p;
-      p.file = programs_[i].file;
-      p.dialect = m.dialect;
-      p.log_file = programs_[i].program.log_file;
-      p.role = programs_[i].role;
-      p.start_s = plan_.start_s[i];
-      p.duration_s = plan_.duration_s[i];
-      m.programs.push_back(p);
-    }
-    m.machine_name = m_.name;
-    m.c_axis_centre_mm = m_.c_axis_centre_mm;
-    m.c_positive_is_clockwise = m_.c.positive_is_clockwise;
-    m.table_surface_z_mm = m_.table_surface_z_mm;
-    m.coordinate_resolution_mm = std::max({m_.x.resolution_mm, m_.y.resolution_mm, m_.z.resolution_mm});
-    m.probe_tool = m_.probe.tool;
+    setManifestPrograms(m, programs_, plan_.start_s, plan_.duration_s);
+    setManifestMachine(m, m_);
     m.tip_radius_mm = rt_;
     // The piece's stylus and its stated repeatability (L769: +-2 um, read as 2 sigma).
     m.probe_repeatability_2sigma_um = w_.probing.repeatability_mm * 1e3;
-    m.probe_tool_change_repeatability_2sigma_um = m_.probe.tool_change_repeatability_2sigma_um;
     m.part_name = w_.name;
     m.part_origin_mm = O_;
     m.material_name = w_.material.name;
@@ -653,16 +630,7 @@ class Builder {
     }
     s.cmm = w_.cmm;
     s.cmm_plan = files_.cmm_points;
-    for (auto& f : m.features) {
-      double first = INFINITY, last = -INFINITY;
-      for (const auto& k : m.cuts)
-        if (k.feature == f.nominal.id) {
-          first = std::min(first, k.start_s);
-          last = std::max(last, k.end_s);
-          f.cycle = k.cycle;
-        }
-      if (std::isfinite(first)) f.cut_time_s = (first + last) / 2;
-    }
+    setFeatureCutTimes(m);
     const std::size_t pr = programs_.size() - 1;
     m.cycles = 1;
     m.gap_s = 0;
@@ -670,22 +638,11 @@ class Builder {
     m.cycle_start_s = {plan_.start_s[pr]};
   }
 
-  struct CmmRow {
-    std::string feature;
-    int point;
-    Vector3d p, n;
-  };
   std::string cmmCsv() const {
-    std::ostringstream o;
-    o << "# probeloop plan: CMM points of " << w_.name << ", experiment " << e_->id
-      << " - nominal surface points and outward unit normals,\n"
-      << "# part frame at 20 C (origin at a corner of the top step in its top face, X and Y along its walls), mm\n";
-    o << "feature,point,x_mm,y_mm,z_mm,nx,ny,nz\n";
-    for (const auto& r : cmm_)
-      o << r.feature << "," << r.point << "," << formatNumber(r.p.x(), 6) << "," << formatNumber(r.p.y(), 6) << ","
-        << formatNumber(r.p.z(), 6) << "," << formatNumber(r.n.x(), 6) << "," << formatNumber(r.n.y(), 6) << ","
-        << formatNumber(r.n.z(), 6) << "\n";
-    return o.str();
+    return cmmPointsCsv({"probeloop plan: CMM points of " + w_.name + ", experiment " + e_->id +
+                             " - nominal surface points and outward unit normals,",
+                         "part frame at 20 C (origin at a corner of the top step in its top face, X and Y along its walls), mm"},
+                        cmm_);
   }
 
   const SteppedWorkpiece& w_;

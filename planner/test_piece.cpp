@@ -67,20 +67,30 @@ TestPiecePlan sphere(const parts::SphereArtifact& a, const parts::Machine& m, pa
   return out;
 }
 
+// The planned programs of a machined test piece as `plan` writes them: text in the dialect,
+// start and duration on the planned clock.
+std::vector<PlannedProgram> plannedPrograms(const std::vector<NotedProgram>& programs, const std::vector<double>& start_s,
+                                            const std::vector<double>& duration_s, parts::Dialect dialect) {
+  std::vector<PlannedProgram> out;
+  for (std::size_t i = 0; i < programs.size(); ++i) {
+    PlannedProgram p;
+    p.role = programs[i].role;
+    p.file = programs[i].file;
+    p.text = dialect == parts::Dialect::LinuxCnc ? gcode::writeLinuxCnc(programs[i].program)
+                                                 : gcode::writeFanucMacroB(programs[i].program);
+    p.start_s = start_s[i];
+    p.duration_s = duration_s[i];
+    out.push_back(p);
+  }
+  return out;
+}
+
 TestPiecePlan thermal(const parts::TestPiece& piece, const parts::ThermalTestPiece& t, const parts::Machine& m,
                       parts::Dialect dialect, const std::string& out_dir) {
   // The features and evaluation rules of the loaded test piece, as the manifest carries them.
   auto plan = planThermalTestPiece(t, piece.features, piece.evaluation, m, dialect);
   TestPiecePlan out;
-  for (std::size_t i = 0; i < plan.programs.size(); ++i) {
-    PlannedProgram p;
-    p.role = plan.programs[i].role;
-    p.file = plan.programs[i].file;
-    p.text = ttpProgramText(plan.programs[i], dialect);
-    p.start_s = plan.start_s[i];
-    p.duration_s = plan.duration_s[i];
-    out.programs.push_back(p);
-  }
+  out.programs = plannedPrograms(plan.programs, plan.start_s, plan.duration_s, dialect);
   const auto& man = plan.manifest;
   out.files.emplace_back(man.ttp.cmm_plan, plan.cmm_points_csv);
 
@@ -168,15 +178,7 @@ TestPiecePlan stepped(const parts::SteppedWorkpiece& w, const std::string& exper
   }
   auto plan = planSteppedWorkpiece(w, experiment, m, dialect);
   TestPiecePlan out;
-  for (std::size_t i = 0; i < plan.programs.size(); ++i) {
-    PlannedProgram p;
-    p.role = plan.programs[i].role;
-    p.file = plan.programs[i].file;
-    p.text = swProgramText(plan.programs[i], dialect);
-    p.start_s = plan.start_s[i];
-    p.duration_s = plan.duration_s[i];
-    out.programs.push_back(p);
-  }
+  out.programs = plannedPrograms(plan.programs, plan.start_s, plan.duration_s, dialect);
   const auto& man = plan.manifest;
   out.files.emplace_back(man.sw.cmm_plan, plan.cmm_points_csv);
   const auto* e = w.experiment(experiment);

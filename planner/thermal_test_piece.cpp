@@ -11,6 +11,7 @@
 #include "core/units.hpp"
 #include "parts/test_piece.hpp"
 #include "planner/angles.hpp"
+#include "planner/piece_manifest.hpp"
 
 namespace probeloop::planner {
 
@@ -1003,7 +1004,7 @@ class Builder {
       });
       plan_.start_s.push_back(t0);
       plan_.duration_s.push_back(walker.time() - t0);
-      plan_.times.push_back(minus(walker.times(), total_));
+      plan_.times.push_back(walker.times() - total_);
       total_ = walker.times();
       if (p.role == "test") {
         for (std::size_t c = 0; c < man_.cut_cycles.size(); ++c) {
@@ -1016,43 +1017,15 @@ class Builder {
       }
     }
   }
-  static WalkTimes minus(const WalkTimes& a, const WalkTimes& b) {
-    WalkTimes d;
-    d.tool_change_s = a.tool_change_s - b.tool_change_s;
-    d.rapid_s = a.rapid_s - b.rapid_s;
-    d.rotary_index_s = a.rotary_index_s - b.rotary_index_s;
-    d.feed_s = a.feed_s - b.feed_s;
-    d.rotary_feed_s = a.rotary_feed_s - b.rotary_feed_s;
-    d.protected_s = a.protected_s - b.protected_s;
-    d.probing_s = a.probing_s - b.probing_s;
-    d.dwell_s = a.dwell_s - b.dwell_s;
-    return d;
-  }
-
   // --- manifest and CMM plan --------------------------------------------------------------
   void manifest() {
     auto& m = man_;
     m.kind = "thermal_test_piece";
     m.dialect = parts::dialectName(dialect_);
-    for (std::size_t i = 0; i < programs_.size(); ++i) {
-      parts::ManifestProgram p;
-      p.file = programs_[i].file;
-      p.dialect = m.dialect;
-      p.log_file = programs_[i].program.log_file;
-      p.role = programs_[i].role;
-      p.start_s = plan_.start_s[i];
-      p.duration_s = plan_.duration_s[i];
-      m.programs.push_back(p);
-    }
-    m.machine_name = m_.name;
-    m.c_axis_centre_mm = m_.c_axis_centre_mm;
-    m.c_positive_is_clockwise = m_.c.positive_is_clockwise;
-    m.table_surface_z_mm = m_.table_surface_z_mm;
-    m.coordinate_resolution_mm = std::max({m_.x.resolution_mm, m_.y.resolution_mm, m_.z.resolution_mm});
-    m.probe_tool = m_.probe.tool;
+    setManifestPrograms(m, programs_, plan_.start_s, plan_.duration_s);
+    setManifestMachine(m, m_);
     m.tip_radius_mm = m_.probe.tip_diameter_mm / 2;
     m.probe_repeatability_2sigma_um = m_.probe.repeatability_2sigma_um;
-    m.probe_tool_change_repeatability_2sigma_um = m_.probe.tool_change_repeatability_2sigma_um;
     m.part_name = t_.name;
     m.part_origin_mm = O_;
     m.material_name = t_.material.name;
@@ -1068,17 +1041,7 @@ class Builder {
     c.on_machine_repeatability_um = t_.on_machine_repeatability_um;
     c.on_machine_temperature_change_K = t_.on_machine_temperature_change_K;
     c.cmm_plan = files_.cmm_points;
-    // Each feature: the cycle and the mid time of the cut(s) that finish it.
-    for (auto& f : m.features) {
-      double first = INFINITY, last = -INFINITY;
-      for (const auto& k : m.cuts)
-        if (k.feature == f.nominal.id) {
-          first = std::min(first, k.start_s);
-          last = std::max(last, k.end_s);
-          f.cycle = k.cycle;
-        }
-      if (std::isfinite(first)) f.cut_time_s = (first + last) / 2;
-    }
+    setFeatureCutTimes(m);  // the cycle and the mid time of the cut(s) that finish each feature
     const std::size_t insp = programs_.size() - 1;
     m.cycles = 1;
     m.gap_s = 0;
@@ -1086,21 +1049,10 @@ class Builder {
     m.cycle_start_s = {plan_.start_s[insp]};
   }
 
-  struct CmmRow {
-    std::string feature;
-    int point;
-    Vector3d p, n;
-  };
   std::string cmmCsv() const {
-    std::ostringstream o;
-    o << "# probeloop plan: CMM points of " << t_.name << " - nominal surface points and outward unit normals,\n"
-      << "# part frame at 20 C (origin on the C axis in the finished top face, X along the large notch), mm\n";
-    o << "feature,point,x_mm,y_mm,z_mm,nx,ny,nz\n";
-    for (const auto& r : cmm_)
-      o << r.feature << "," << r.point << "," << formatNumber(r.p.x(), 6) << "," << formatNumber(r.p.y(), 6) << ","
-        << formatNumber(r.p.z(), 6) << "," << formatNumber(r.n.x(), 6) << "," << formatNumber(r.n.y(), 6) << ","
-        << formatNumber(r.n.z(), 6) << "\n";
-    return o.str();
+    return cmmPointsCsv({"probeloop plan: CMM points of " + t_.name + " - nominal surface points and outward unit normals,",
+                         "part frame at 20 C (origin on the C axis in the finished top face, X along the large notch), mm"},
+                        cmm_);
   }
 
   const ThermalTestPiece& t_;
