@@ -158,6 +158,9 @@ SteppedWorkpiece loadSteppedWorkpiece(const std::string& path) {
     w.steps.push_back(st);
   }
   if (w.steps.size() < 2 || w.steps.size() > 8) root.fail("steps", "expected 2 to 8 steps (the thesis's piece has 4)");
+  // The blank's bottom lies blank_height - finishing_margin below the part's top; the base
+  // under the deepest floor keeps kMinBase (our choice) so no cut comes near the fixture.
+  constexpr double kMinBase = 5.0;
   if (!(w.steps.back().floor_depth_mm < w.blank_height_mm))
     root.fail("steps", "the deepest floor (" + formatNumber(w.steps.back().floor_depth_mm) + " mm) must lie above the blank's bottom (height " +
                            formatNumber(w.blank_height_mm) + " mm)");
@@ -169,6 +172,12 @@ SteppedWorkpiece loadSteppedWorkpiece(const std::string& path) {
     root.fail("alternative_sizes", "expected one size per step (" + std::to_string(w.steps.size()) + ")");
   checkSizes(root, "alternative_sizes", w.alternative_sizes_mm, w.blank_x_mm, w.blank_y_mm, tool->diameter_mm);
   w.finishing_margin_mm = root.positiveQuantity("finishing_margin", Dimension::Length);
+  if (!(w.steps.back().floor_depth_mm <= w.blank_height_mm - w.finishing_margin_mm - kMinBase + 1e-9))
+    root.fail("steps", "the deepest floor (" + formatNumber(w.steps.back().floor_depth_mm) + " mm) leaves " +
+                           formatNumber(w.blank_height_mm - w.finishing_margin_mm - w.steps.back().floor_depth_mm) +
+                           " mm of base above the fixture (blank.height " + formatNumber(w.blank_height_mm) + " mm less the " +
+                           formatNumber(w.finishing_margin_mm) + " mm margin above the top); at least " + formatNumber(kMinBase) +
+                           " mm are needed");
 
   // The clamp holes stand in the blank's corners, outside the largest step and its tool path.
   if (w.clamp_holes) {
@@ -230,7 +239,6 @@ SteppedWorkpiece loadSteppedWorkpiece(const std::string& path) {
     auto& g = w.machining;
     g.roughing_spindle_rpm = r.positiveQuantity("spindle_speed", Dimension::RotSpeed);
     g.roughing_feed_xy_mm_per_min = r.positiveQuantity("feed_xy", Dimension::Feed);
-    g.roughing_feed_z_mm_per_min = r.positiveQuantity("feed_z", Dimension::Feed);
     g.roughing_depth_per_level_mm = r.positiveQuantity("depth_per_level", Dimension::Length);
     if (!(g.roughing_depth_per_level_mm <= tool->flute_length_mm))
       r.fail("depth_per_level", formatNumber(g.roughing_depth_per_level_mm) + " mm is deeper than the flutes of T" +
@@ -272,7 +280,11 @@ std::vector<SwProbePoint> probePoints(const SteppedWorkpiece& w, const std::vect
     bool ok = f.role == "floor" ? f.radius_mm >= keep
                                 : std::abs(d.dot(f.u)) <= f.half_u_mm - keep + 1e-9 && std::abs(d.dot(f.v())) <= f.half_v_mm - keep + 1e-9;
     for (const auto& c : clampHoleCentres(w))
-      if ((p.head<2>() - c).norm() < w.clamp_hole_diameter_mm / 2 + keep) ok = false;
+      if ((p.head<2>() - c).norm() < w.clamp_hole_diameter_mm / 2 + keep)
+        throw InputError(w.file, 0, "feature " + f.id + ": point " + std::to_string(n + 1) + " lies " +
+                                        formatNumber((p.head<2>() - c).norm(), 3) + " mm from the centre of a clamp hole (x " +
+                                        formatNumber(c.x()) + ", y " + formatNumber(c.y()) + "), within its radius + " +
+                                        formatNumber(keep) + " mm; move the holes (blank.clamp_holes.inset) or the points");
     if (!ok)
       throw InputError(w.file, 0, "feature " + f.id + ": point " + std::to_string(n + 1) + " lies within " + formatNumber(keep) +
                                       " mm (the ball's radius + 0.5 mm) of the face's edge; move it inward or use a smaller ball");

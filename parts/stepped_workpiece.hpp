@@ -74,7 +74,7 @@ struct SwProbing {
 // of roughing contours and floor passes, the lead past a wall's roughed end before a
 // non-cutting transition, the clearance plane above the blank.
 struct SwMachining {
-  double roughing_spindle_rpm = 0, roughing_feed_xy_mm_per_min = 0, roughing_feed_z_mm_per_min = 0;
+  double roughing_spindle_rpm = 0, roughing_feed_xy_mm_per_min = 0;
   double roughing_depth_per_level_mm = 0;
   double stepover = 0;  // of the tool's diameter
   double lead_mm = 0;

@@ -235,6 +235,9 @@ TEST(SteppedWorkpiece, BadDescriptionsAreRefusedWithTheLine) {
   EXPECT_TRUE(std::regex_search(small, std::regex(R"(\.yaml:[0-9]+: steps: step 2 \(25 mm\) must be larger than step 1)"))) << small;
   expectRefused(variant("{size: 80 mm, floor_depth: 29 mm}", "{size: 80 mm, floor_depth: 15 mm}"), "floor_depth: must be deeper than the floor of the step above (19 mm)");
   expectRefused(variant("height: 50 mm ", "height: 30 mm "), "the deepest floor (37 mm) must lie above");
+  // 50 - 0.5 - 37 = 12.5 mm of base; 45 mm would leave 4.5, under the 5 mm kept above the fixture.
+  expectRefused(variant("{size: 99 mm, floor_depth: 37 mm}", "{size: 99 mm, floor_depth: 45 mm}"),
+                "the deepest floor (45 mm) leaves 4.5 mm of base above the fixture");
   expectRefused(variant("size: [150 mm, 150 mm]", "size: [110 mm, 150 mm]"), "leaves 5.5 mm to the blank's edge");
   expectRefused(variant("      - {feed_xy: 800, feed_z: 800, spindle_speed: 3500}\n  - id: W4",
                               "  - id: W4"), "steps: expected 4 entries, one per step of the workpiece, got 3");

@@ -38,7 +38,9 @@ struct Material {
   std::vector<Box> boxes() const {
     const double m = w.finishing_margin_mm, c_bottom = w.blankTopZ() - w.blank_height_mm;
     const double bx = w.blank_x_mm / 2, by = w.blank_y_mm / 2;
-    if (blank) return {{bx, by, c_bottom, w.blankTopZ()}};
+    if (blank)
+      return {{bx, by, c_bottom, w.blankTopZ()},
+              {w.fixture_diameter_mm / 2, w.fixture_diameter_mm / 2, c_bottom - w.fixture_height_mm, c_bottom}};
     std::vector<Box> out;
     const std::size_t n = half.size();
     for (std::size_t j = 0; j < n; ++j) {
@@ -49,6 +51,8 @@ struct Material {
     }
     const double base_top = -w.steps.back().floor_depth_mm + (static_cast<int>(n) < tops_finished ? 0.0 : m);
     out.push_back({bx, by, c_bottom, base_top});
+    // The fixture under the blank (a box round its circle: the safe side).
+    out.push_back({w.fixture_diameter_mm / 2, w.fixture_diameter_mm / 2, c_bottom - w.fixture_height_mm, c_bottom});
     return out;
   }
 };
@@ -138,6 +142,19 @@ class Builder {
                                          formatNumber(round4(m_.z.min_mm - lowest_tip)) + " mm");
     };
     reach(tool_->length_mm, deepest, "tools[T" + std::to_string(tool_->number) + "].length", "the finishing tool");
+    // A tool is changed at the tool-change height: the new tool (or the probe) must hang
+    // above the clearance plane there, or it is loaded (and the spindle started) in the part.
+    auto hangs = [&](double length, double tip_z, const std::string& what) {
+      if (m_.tool_change.z_mm - length < tip_z - 1e-9)
+        throw InputError(m_.file, 0, "tool_change.z: " + formatNumber(m_.tool_change.z_mm) + " mm puts the tip of " + what + " (" +
+                                         formatNumber(length) + " mm) at Z " + formatNumber(round4(m_.tool_change.z_mm - length)) +
+                                         ", below the clearance plane of " + w_.file + " (tip Z " + formatNumber(round4(tip_z)) + ")");
+    };
+    hangs(tool_->length_mm, clear, "tool T" + std::to_string(tool_->number));
+    hangs(m_.probe.length_mm, O_.z() + rt_ + w_.machining.clearance_mm, "the probe");
+    if (!(step_ > 0.1))
+      throw InputError(w_.file, 0, "tools[T" + std::to_string(tool_->number) + "].diameter: " + formatNumber(tool_->diameter_mm) +
+                                       " mm is too small for the contours (step " + formatNumber(step_) + " mm)");
     reach(m_.probe.length_mm, deepest + rt_, "probe.length (" + m_.file + ")", "the probe");
   }
 
@@ -227,9 +244,9 @@ class Builder {
 
   // One closed square contour of half size s about the centre, clockwise from its (-s, s)
   // corner (where the tool stands).
-  void contour(double s, double F, const std::string& w, int ci) {
+  void contour(double s, double F, const std::string& w, int ci, bool cut = true) {
     const Vector2d corners[4] = {{s, s}, {s, -s}, {-s, -s}, {-s, s}};
-    for (const auto& q : corners) feedXY(q, F, w, true, ci);
+    for (const auto& q : corners) feedXY(q, F, w, cut, ci);
   }
 
   // --- roughing (our choice: the thesis's preparation, L695-700) ----------------------------
@@ -301,7 +318,7 @@ class Builder {
       const double s = rings[j];
       const int c = ci(gk + "_F-" + std::to_string(j + 1), gk + "_F", Vector2d(-s, s), Vector2d(-s, s));
       if (j) feedXY(Vector2d(-s, s), F, w + ": floor, in to the next contour", !air);  // before the cut's from_mm
-      contour(s, F, w + ": floor contour " + std::to_string(j + 1), c);
+      contour(s, F, w + ": floor contour " + std::to_string(j + 1), c, !air);
     }
     if (!air) material_.tops_finished = static_cast<int>(k) + 2;
     // Walls, clockwise from +Y: YP moving +X, XP moving -Y, YN moving -X, XN moving +Y.
@@ -508,13 +525,14 @@ class Builder {
              " below the top of the part (a G0 may dog-leg: only G1 there)");
     }
     if (mo.note->cut || mo.note->retract || mo.kind == MotionKind::Measuring) return;
-    if (mo.kind == MotionKind::MachineZ) return;  // straight up to the tool-change height
+    if (mo.kind == MotionKind::MachineZ && qb.z() >= qa.z()) return;  // straight up to the tool-change height
     // Straight up: in every state the material only narrows upward (roughing clears each level
     // at least as wide as the one below it; the steps shrink upward), so nothing is met.
     if ((qa.head<2>() - qb.head<2>()).norm() < 1e-9 && qb.z() >= qa.z()) return;
     const auto boxes = mat.boxes();
+    // Samples 0.02 mm apart: a graze between two of them stays under 0.01 mm.
     const double len = (qb - qa).norm();
-    const int n = std::max(1, static_cast<int>(std::ceil(len / 0.25)));
+    const int n = std::max(1, static_cast<int>(std::ceil(len / 0.02)));
     for (int i = 0; i <= n; ++i) {
       const Vector3d q = qa + (qb - qa) * (static_cast<double>(i) / n);
       for (const auto& b : boxes) {

@@ -15,17 +15,19 @@
 // the top, raster along X from outside the top), the floor ring from outside in at its depth
 // (plunge at feed_z, contours at feed_xy), then the four walls in one full-height pass each,
 // joined by the experiment's transition — non_cutting and fast: each wall is cut past both
-// roughed ends by the lead and the tool moves to the next wall's start at the transition feed
-// without touching; continuous: one closed contour at the cutting feed. The warm-up before
+// roughed ends by the lead and the tool moves to the next wall's start at the transition feed,
+// clear of the walls, its end face at the floor's depth; continuous: one closed contour at the cutting feed. The warm-up before
 // step k + 1: spindle idle at that step's speed for procedure.warm_up.spindle_idle, then
 // (axis_manoeuvre) that step's path replayed in the air at the clearance plane.
 //
 // Contract: InputError (file, key, value) before any text exists for an unknown experiment, a
 // feed above the machine's axes, a tool or probe that cannot reach the deepest cut or clear
-// the part within the Z travel; SafetyError "<program>: <operation>: ..." for a target
+// the part within the Z travel, a tool-change height that leaves a tool below the clearance
+// plane; SafetyError "<program>: <operation>: ..." for a target
 // outside the travel, a tool or stylus that would touch material outside an intended cut (the
-// material as roughing and finishing leave it, face by face), a G0 of several axes below the
-// top of the blank — all checked by walking the programs with the simulator's clock
+// material as roughing and finishing leave it, face by face, and the fixture; straight-up
+// moves are exempt: the material only narrows upward), a G0 of several axes below the top of
+// the part — all checked by walking the programs with the simulator's clock
 // (planner/program_walker.hpp).
 #pragma once
 #include <string>

@@ -225,6 +225,12 @@ TEST(PlanSteppedWorkpiece, RefusesWhatTheMachineCannotDo) {
   // ... and a 100 mm tool cannot reach the deepest floor (tip Z 37.5) from Z 150.
   const auto shortTool = piece(variantOf(shipped, "length: 140 mm", "length: 100 mm"));
   EXPECT_NE(refusal(shortTool, "W8", m).find("cannot reach down to tip Z 37.5"), std::string::npos) << refusal(shortTool, "W8", m);
+  // A tool change at Z 200 would hang the 140 mm tool's tip at Z 60, inside the blank (its top
+  // at 75, the clearance plane at 85): refused, naming the machine's key.
+  const auto low = parts::loadMachine(variantOf(src + "/parts/machines/vmc3.yaml", "  z: 550 mm", "  z: 200 mm"));
+  EXPECT_NE(refusal(piece(), "W8", low).find("tool_change.z: 200 mm puts the tip of tool T1 (140 mm) at Z 60, below the clearance plane"),
+            std::string::npos)
+      << refusal(piece(), "W8", low);
 }
 
 }  // namespace
