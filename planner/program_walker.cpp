@@ -34,6 +34,19 @@ double rapidSeconds(const parts::Machine& m, const Vector3d& d, double db, doubl
 double linearFeedSeconds(double path_mm, double F) { return path_mm / F * 60.0; }
 double rotaryFeedSeconds(double delta_deg, double F) { return std::fabs(delta_deg) / F * 60.0; }
 
+NotedProgram newNotedProgram(const parts::Machine& m, const std::string& role, const std::string& file, int number,
+                             const std::string& title) {
+  NotedProgram p;
+  p.role = role;
+  p.file = file;
+  p.program.title = title;
+  p.program.number = number;
+  p.program.work_offset = m.work_offset;
+  p.program.has_b_axis = m.b.present;
+  p.program.has_c_axis = m.c.present;
+  return p;
+}
+
 void NotedProgram::add(gcode::Op op, OpNote note) {
   if (!gcode::allFinite(op))
     throw GeometryError(file + ": " + note.where + ": a coordinate, feed or time that is not a finite number " +

@@ -53,6 +53,11 @@ struct NotedProgram {
   void add(gcode::Op op, OpNote note);
 };
 
+// An empty program for this machine: its work offset (zeroed by the program) and the rotary
+// axes it has.
+NotedProgram newNotedProgram(const parts::Machine& m, const std::string& role, const std::string& file, int number,
+                             const std::string& title);
+
 // A tool the walker knows: from the part's tool list, the machine's probe, the empty spindle.
 struct WalkerTool {
   int number = 0;

@@ -84,7 +84,6 @@ class Builder {
     // Square contours cover their corners only with a step of at most r sqrt 2.
     step_ = std::min(w.machining.stepover * tool_->diameter_mm, r_ * std::sqrt(2.0) - 0.01);
     z_clear_ = w.blankTopZ() + w.machining.clearance_mm;
-    travel_feed_ = std::min({m.rapid_feed_mm_per_min, m.x.max_feed_mm_per_min, m.y.max_feed_mm_per_min, m.z.max_feed_mm_per_min});
     checkInputs();
   }
 
@@ -208,15 +207,7 @@ class Builder {
   }
 
   void newProgram(const std::string& role, const std::string& file, int number, const std::string& title) {
-    NotedProgram p;
-    p.role = role;
-    p.file = file;
-    p.program.title = title;
-    p.program.number = number;
-    p.program.work_offset = m_.work_offset;
-    p.program.has_b_axis = m_.b.present;
-    p.program.has_c_axis = m_.c.present;
-    programs_.push_back(std::move(p));
+    programs_.push_back(newNotedProgram(m_, role, file, number, title));
     states_.emplace_back();
     P().program.header = {
         "machine: " + m_.name,
@@ -672,7 +663,7 @@ class Builder {
   std::vector<parts::NominalFeature> features_;
   Vector3d O_;
   const parts::CuttingTool* tool_ = nullptr;
-  double r_ = 0, rt_ = 0, c_ = 0, step_ = 0, z_clear_ = 0, travel_feed_ = 0;
+  double r_ = 0, rt_ = 0, c_ = 0, step_ = 0, z_clear_ = 0;
   Vector2d pos_ = Vector2d::Zero();  // current XY relative to the steps' centre (builder's view)
   Material material_;
   std::vector<std::vector<Material>> states_;  // per program, per op: the material the op moves in

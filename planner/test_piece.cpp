@@ -67,6 +67,21 @@ TestPiecePlan sphere(const parts::SphereArtifact& a, const parts::Machine& m, pa
   return out;
 }
 
+// One program's time by kind of op, as the summary prints it (kinds under 0.05 s left out).
+std::string timesLine(const WalkTimes& w) {
+  const std::pair<const char*, double> kinds[] = {
+      {"feeds", w.feed_s},         {"C turned by feed", w.rotary_feed_s}, {"rapids", w.rapid_s},
+      {"indexing", w.rotary_index_s}, {"tool changes", w.tool_change_s},  {"protected moves", w.protected_s},
+      {"probing", w.probing_s},    {"dwells", w.dwell_s}};
+  std::string out, sep = "    ";
+  for (const auto& [name, v] : kinds)
+    if (v > 0.05) {
+      out += sep + name + " " + formatNumber(v, 1) + " s";
+      sep = ", ";
+    }
+  return out + "\n";
+}
+
 // The planned programs of a machined test piece as `plan` writes them: text in the dialect,
 // start and duration on the planned clock.
 std::vector<PlannedProgram> plannedPrograms(const std::vector<NotedProgram>& programs, const std::vector<double>& start_s,
@@ -111,18 +126,7 @@ TestPiecePlan thermal(const parts::TestPiece& piece, const parts::ThermalTestPie
     if (i == 2) s << ": " << man.points.size() << " probed points, log " << plan.programs[i].program.log_file;
     if (notes[i][0]) s << " (" << notes[i] << ")";
     s << "\n";
-    const auto& w = plan.times[i];
-    const std::pair<const char*, double> parts[] = {
-        {"feeds", w.feed_s},         {"C turned by feed", w.rotary_feed_s}, {"rapids", w.rapid_s},
-        {"indexing", w.rotary_index_s}, {"tool changes", w.tool_change_s},  {"protected moves", w.protected_s},
-        {"probing", w.probing_s},    {"dwells", w.dwell_s}};
-    std::string sep = "    ";
-    for (const auto& [name, v] : parts)
-      if (v > 0.05) {
-        s << sep << name << " " << formatNumber(v, 1) << " s";
-        sep = ", ";
-      }
-    s << "\n";
+    s << timesLine(plan.times[i]);
   }
   const int surfaces = t.z_paths + 4 * t.facets_per_segment;
   s << surfaces << " measurement surfaces: " << t.z_paths << " Z paths (" << formatNumber(t.z_path_pitch_mm) << " mm pitch) + "
@@ -199,17 +203,7 @@ TestPiecePlan stepped(const parts::SteppedWorkpiece& w, const std::string& exper
       << " (" << formatNumber(p.duration_s, 1) << " s)";
     if (p.role == "probing") s << ": " << man.points.size() << " probed points, log " << plan.programs[i].program.log_file;
     s << "\n";
-    const auto& t = plan.times[i];
-    const std::pair<const char*, double> parts[] = {{"feeds", t.feed_s},         {"rapids", t.rapid_s},
-                                                    {"tool changes", t.tool_change_s}, {"protected moves", t.protected_s},
-                                                    {"probing", t.probing_s},   {"dwells", t.dwell_s}};
-    std::string sep = "    ";
-    for (const auto& [name, v] : parts)
-      if (v > 0.05) {
-        s << sep << name << " " << formatNumber(v, 1) << " s";
-        sep = ", ";
-      }
-    s << "\n";
+    s << timesLine(plan.times[i]);
   }
   s << "Steps (Temp state T = mid-time of the step's wall cuts from the start of step 1, min):\n";
   for (const auto& st : plan.steps)

@@ -444,14 +444,7 @@ class Builder {
   }
 
   void newProgram(const std::string& role, const std::string& file, int number, const std::string& title) {
-    NotedProgram p;
-    p.role = role;
-    p.file = file;
-    p.program.title = title;
-    p.program.number = number;
-    p.program.work_offset = m_.work_offset;
-    p.program.has_b_axis = m_.b.present;
-    programs_.push_back(std::move(p));
+    programs_.push_back(newNotedProgram(m_, role, file, number, title));
     current_tool_ = -1;
     spindle_on_ = false;
     P().program.header = {
