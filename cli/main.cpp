@@ -82,7 +82,7 @@ int cmdSynth(const std::string& manifest_file, const std::string& truth_file,
 
 int cmdSimulate(const std::vector<std::string>& program_files, const std::string& machine_file,
                 const std::string& part_file, const std::string& truth_file, const std::string& out_dir,
-                std::uint64_t seed, const std::string& cmm_file, bool trace) {
+                std::uint64_t seed, const std::string& cmm_file, bool trace, const std::string& schedule_file) {
   const auto machine = parts::loadMachine(machine_file);
   const auto truth = sim::loadMachineTruth(truth_file);
   const auto piece = parts::loadTestPiece(part_file);
@@ -94,7 +94,21 @@ int cmdSimulate(const std::vector<std::string>& program_files, const std::string
   }
   part.trace = trace;
   std::vector<sim::ProgramSource> programs;
-  for (const auto& f : program_files) programs.push_back({f, readFile(f)});
+  for (const auto& f : program_files) programs.push_back({f, readFile(f), std::nullopt});
+  if (!schedule_file.empty()) {
+    // Each program starts at its planned time; the machine is off in between.
+    const auto m = parts::readManifest(schedule_file);
+    for (auto& p : programs) {
+      const std::string name = fs::path(p.file).filename().string();
+      std::string planned;
+      for (const auto& mp : m.programs) {
+        if (mp.file == name) p.start_s = mp.start_s;
+        planned += (planned.empty() ? "" : ", ") + mp.file;
+      }
+      if (!p.start_s)
+        throw InputError(schedule_file, 0, "programs[].file: '" + name + "' is not planned here (the manifest plans " + planned + ")");
+    }
+  }
   const auto s = sim::simulatePrograms(programs, machine, part, truth, seed);
   std::string written;
   for (const auto& l : s.logs) {
@@ -127,13 +141,15 @@ int cmdSimulate(const std::vector<std::string>& program_files, const std::string
 
 int cmdEvaluate(const std::string& points_file, const std::string& manifest_file, const std::string& out_dir,
                 const std::string& format, bool free_radius, const std::string& scene_file,
-                std::optional<double> exaggeration_opt, const std::string& compare_with, double gauge_resolution_um) {
+                std::optional<double> exaggeration_opt, const std::string& compare_with, double gauge_resolution_um,
+                const std::string& probe_log) {
   const auto m = parts::readManifest(manifest_file);
   evaluate::EvaluateRequest req;
   req.input_file = points_file;
   req.format = format;
   req.free_radius = free_radius;
   req.compare_with = compare_with;
+  req.probe_log = probe_log;
   req.out_dir = out_dir;
   req.gauge_resolution_um = gauge_resolution_um;
   const auto f = evaluate::evaluateTestPiece(m, req);
@@ -279,6 +295,9 @@ int main(int argc, char** argv) {
   simc->add_option("--cmm-points", cmm_points, "machined part: CMM points to measure after the programs "
                    "(feature,point,x_mm,y_mm,z_mm,nx,ny,nz)")->check(CLI::ExistingFile);
   simc->add_flag("--trace", sim_trace, "also write trace.csv: every motion, dwell and tool change with its time and line");
+  std::string schedule;
+  simc->add_option("--schedule", schedule, "plan manifest (plan.json): start each program at its planned time, the machine "
+                   "off in between (the stepped workpiece's 3 h waits)")->check(CLI::ExistingFile);
 
   std::string compare_with;
   auto* ev = app.add_subcommand("evaluate", "Errors of a test piece from probe logs, points CSV, a CMM export or dial-gauge readings");
@@ -293,6 +312,9 @@ int main(int argc, char** argv) {
   ev->add_option("--gauge-resolution-um", gauge_resolution_um,
                  "thermal test piece, dial-gauge readings: the gauge's resolution (rectangular; not stated in the thesis)")
       ->capture_default_str()->check(CLI::PositiveNumber);
+  std::string probe_log;
+  ev->add_option("--probe-log", probe_log, "stepped workpiece: the on-machine probe log, evaluated with the CMM export (seed 000: CMM - probe)")
+      ->check(CLI::ExistingFile);
   ev->add_option("--compare", compare_with, "thermal test piece: another run's evaluation.json (seed 004 Table 7.2 reductions)")
       ->check(CLI::ExistingFile);
 
@@ -342,11 +364,11 @@ int main(int argc, char** argv) {
     if (*plan) return cmdPlan(artifact, machine, out, dialect, experiment);
     if (*res) return cmdResolution(artifact, machine, step_um);
     if (*syn) return cmdSynth(manifest, truth, out, seed);
-    if (*simc) return cmdSimulate(sim_programs, machine, part, truth, out, seed, cmm_points, sim_trace);
+    if (*simc) return cmdSimulate(sim_programs, machine, part, truth, out, seed, cmm_points, sim_trace, schedule);
     if (*fit) return cmdFit(fa);
     if (*gum) return cmdGum(gum_model, gum_mcm || gum_trials > 0, gum_trials, seed, gum_digits, gum_json);
     if (*ev)
-      return cmdEvaluate(points, manifest, out, format, free_radius, scene, exaggeration, compare_with, gauge_resolution_um);
+      return cmdEvaluate(points, manifest, out, format, free_radius, scene, exaggeration, compare_with, gauge_resolution_um, probe_log);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "probeloop: error: %s\n", e.what());
     return 1;

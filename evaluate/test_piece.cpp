@@ -76,6 +76,31 @@ EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateReq
   return f;
 }
 
+// Seed 000 separates the errors from the CMM and the on-machine measurement of one part:
+// both files together (the CMM export as the points, the probe log with --probe-log).
+EvaluationFiles steppedWorkpiece(const parts::PlanManifest& m, const EvaluateRequest& r) {
+  if (r.free_radius || !r.compare_with.empty())
+    throw InputError("", 0, "--free-radius and --compare do not apply to the stepped workpiece");
+  if (r.probe_log.empty())
+    throw InputError(r.input_file, 0, "the stepped workpiece is evaluated from its CMM export and its on-machine probe "
+                                      "log together: give the log with --probe-log (seed 000 L761: CMM - probe)");
+  const std::string text = readFile(r.input_file);
+  const std::string fmt = r.format == "auto" ? detectTtpFormat(r.input_file, text) : r.format;
+  if (fmt != "cmm") throw InputError(r.input_file, 0, "expected the CMM export (feature,point,x_mm,y_mm,z_mm,...), found a " + fmt + " file");
+  const std::string log = readFile(r.probe_log);
+  const std::string log_fmt = detectTtpFormat(r.probe_log, log);
+  if (log_fmt == "cmm" || log_fmt == "gauge")
+    throw InputError(r.probe_log, 0, "--probe-log: expected the on-machine probe log (PT lines) or points CSV, found a " + log_fmt + " file");
+  EvaluationFiles f;
+  f.stepped_workpiece = evaluateSteppedWorkpiece(m, readTtpCmmExport(r.input_file, text, m), readTtpOnMachine(r.probe_log, log, log_fmt, m));
+  const auto& e = *f.stepped_workpiece;
+  f.errors_csv = swErrorsCsv(e);
+  f.evaluation_json = swEvaluationJson(e);
+  f.report_md = swReport(e);
+  f.stdout_text = swStdout(e, r.out_dir);
+  return f;
+}
+
 }  // namespace
 
 EvaluationFiles evaluateTestPiece(const parts::PlanManifest& m, const EvaluateRequest& r) {
@@ -84,8 +109,11 @@ EvaluationFiles evaluateTestPiece(const parts::PlanManifest& m, const EvaluateRe
       throw InputError("", 0, "--compare applies to the thermal test piece (seed 004 Table 7.2), not to a sphere-artifact campaign");
     return sphere(m, r);
   }
+  if (!r.probe_log.empty() && m.kind != "stepped_workpiece")
+    throw InputError("", 0, "--probe-log applies to the stepped workpiece (its CMM export and probe log together)");
   if (m.kind == "thermal_test_piece") return thermalTestPiece(m, r);
-  throw InputError(m.file, 0, "manifest kind '" + m.kind + "': evaluate knows sphere_artifact and thermal_test_piece");
+  if (m.kind == "stepped_workpiece") return steppedWorkpiece(m, r);
+  throw InputError(m.file, 0, "manifest kind '" + m.kind + "': evaluate knows sphere_artifact, thermal_test_piece and stepped_workpiece");
 }
 
 std::string sphereEvaluationStdout(const CampaignEvaluation& e, const std::string& out_dir) {

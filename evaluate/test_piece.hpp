@@ -10,6 +10,7 @@
 #include <string>
 
 #include "evaluate/sphere_campaign.hpp"
+#include "evaluate/stepped_workpiece.hpp"
 #include "evaluate/thermal_test_piece.hpp"
 #include "parts/plan_manifest.hpp"
 
@@ -23,6 +24,7 @@ struct EvaluateRequest {
   std::string compare_with;      // thermal test piece: another evaluation.json -> Table 7.2 reductions
   std::string out_dir = ".";     // only for the file names printed in stdout_text
   double gauge_resolution_um = 1.0;  // thermal test piece, dial-gauge route (not stated in the thesis)
+  std::string probe_log;         // stepped workpiece: the on-machine probe log beside the CMM export (input_file)
 };
 
 struct EvaluationFiles {
@@ -34,6 +36,7 @@ struct EvaluationFiles {
   // Sphere artifact: the campaign, for --scene (per-cycle sphere centres, reference cycle).
   std::optional<CampaignEvaluation> sphere;
   std::optional<TtpEvaluation> thermal_test_piece;
+  std::optional<SwEvaluation> stepped_workpiece;
 };
 
 // InputError for bad input (file, line, feature, what was expected); kinds other than the two

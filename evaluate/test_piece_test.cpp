@@ -23,10 +23,13 @@ std::string refusal(const parts::PlanManifest& m, const EvaluateRequest& r) {
 TEST(TestPieceDispatch, UnknownKindsAndMisplacedOptionsAreRefused) {
   parts::PlanManifest m;
   m.file = "plan.json";
-  m.kind = "stepped_workpiece";
+  m.kind = "gear";
   EvaluateRequest r;
   r.input_file = "points.csv";
-  EXPECT_NE(refusal(m, r).find("plan.json: manifest kind 'stepped_workpiece': evaluate knows sphere_artifact and thermal_test_piece"),
+  EXPECT_NE(refusal(m, r).find("plan.json: manifest kind 'gear': evaluate knows sphere_artifact, thermal_test_piece and stepped_workpiece"),
+            std::string::npos);
+  m.kind = "stepped_workpiece";
+  EXPECT_NE(refusal(m, r).find("points.csv: the stepped workpiece is evaluated from its CMM export and its on-machine probe log together"),
             std::string::npos);
   EXPECT_EQ(planPrediction(m, 0.001), "");
   m.kind = "sphere_artifact";

@@ -129,6 +129,7 @@ std::string genericManifestJson(const PlanManifest& m) {
                               {"transition", t.transition},
                               {"transition_feed_mm_per_min", t.transition_feed_mm_per_min},
                               {"tool_runout_mm", t.tool_runout_mm},
+                              {"tool_diameter_mm", t.tool_diameter_mm},
                               {"sizes_mm", t.sizes_mm},
                               {"steps", steps},
                               {"cmm", {{"mpe_constant_um", t.cmm.mpe_constant_um},
@@ -265,6 +266,7 @@ void readGeneric(const ordered_json& j, PlanManifest& m) {
     c.transition = t.at("transition");
     c.transition_feed_mm_per_min = t.at("transition_feed_mm_per_min");
     c.tool_runout_mm = t.at("tool_runout_mm");
+    c.tool_diameter_mm = t.at("tool_diameter_mm");
     c.sizes_mm = t.at("sizes_mm").get<std::vector<double>>();
     for (const auto& s : t.at("steps")) {
       ManifestStep x;

@@ -92,6 +92,7 @@ struct ManifestStep {
 struct SteppedWorkpieceConstants {
   std::string experiment, transition;
   double transition_feed_mm_per_min = 0, tool_runout_mm = 0;
+  double tool_diameter_mm = 0;  // the finishing tool (its centre travels size + d between opposite walls)
   std::vector<double> sizes_mm;
   std::vector<ManifestStep> steps;
   CmmSpec cmm;

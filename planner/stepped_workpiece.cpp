@@ -625,6 +625,7 @@ class Builder {
     s.transition = e_->transition;
     s.transition_feed_mm_per_min = e_->transition_feed_mm_per_min;
     s.tool_runout_mm = e_->tool_runout_mm;
+    s.tool_diameter_mm = tool_->diameter_mm;
     s.sizes_mm = sizes_;
     for (const auto& st : plan_.steps) {
       parts::ManifestStep x;

@@ -87,6 +87,20 @@ AsCutFeature asCut(const parts::NominalFeature& f, const Stock& stock) {
     return a;
   }
   samples = sameSurface(std::move(samples));
+  // A floor around a boss (the stepped workpiece's rings, 7.5 mm wide) is mostly covered by
+  // the boss above it, which a 10 mm grid can miss: resample every 2 mm over its extent.
+  if (f.kind == "plane" && samples.size() < 6) {
+    samples.clear();
+    const Vector3d n = f.direction.normalized(), u = f.u.normalized(), v = n.cross(u);
+    const int nu = static_cast<int>(std::floor(1.9 * f.half_u_mm / 2.0)) + 1;
+    const int nv = static_cast<int>(std::floor(1.9 * f.half_v_mm / 2.0)) + 1;
+    for (int i = 0; i < nu; ++i)
+      for (int j = 0; j < nv; ++j) {
+        const double ou = -0.95 * f.half_u_mm + 2.0 * i, ov = -0.95 * f.half_v_mm + 2.0 * j;
+        if (sampleAt(stock, f.point_mm + ou * u + ov * v, n, s)) samples.push_back(s);
+      }
+    samples = sameSurface(std::move(samples));
+  }
   a.points = static_cast<int>(samples.size());
   if (a.points < 3) {
     a.why = "fewer than 3 points of the surface within " + formatNumber(kWindow_mm) +
@@ -224,17 +238,10 @@ namespace {
 nlohmann::ordered_json vec(const Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 nlohmann::ordered_json num(double v) { return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(); }
 
-}  // namespace
-
-void writeTestPieceTruth(const TestPieceTruth& t, nlohmann::ordered_json& jt) {
+nlohmann::ordered_json featuresJson(const std::vector<AsCutFeature>& fs, const std::vector<CutState>& cuts) {
   const auto& names = geometry::LocationErrors::names();
-  jt["test_piece_note"] =
-      "features[].as_cut: the surface as cut, sampled exactly and fitted by least squares (part frame, 20 C, what a "
-      "perfect CMM finds); d_mm/depth_mm/beta_urad in datum_frame (seed 004 L2055); machine: the state when the cut "
-      "that made it started; ttp_cycles: seed 004 Eqs. 7.1-7.5 (7.1/7.2 sign corrected), ETTP_um = Eq. 7.3, "
-      "ETTP_7_9_um = Eq. 7.9, against cycle 0 (docs/simulator.md 3.1)";
   nlohmann::ordered_json features = nlohmann::ordered_json::array();
-  for (const auto& f : t.features) {
+  for (const auto& f : fs) {
     nlohmann::ordered_json j{{"id", f.id}, {"kind", f.kind}, {"role", f.role}, {"points", f.points}};
     if (!f.found) {
       j["as_cut"] = nullptr;
@@ -243,7 +250,7 @@ void writeTestPieceTruth(const TestPieceTruth& t, nlohmann::ordered_json& jt) {
       continue;
     }
     j["cut_index"] = f.cut;
-    const CutState* cs = f.cut >= 0 && f.cut < static_cast<int>(t.cuts.size()) ? &t.cuts[static_cast<std::size_t>(f.cut)] : nullptr;
+    const CutState* cs = f.cut >= 0 && f.cut < static_cast<int>(cuts.size()) ? &cuts[static_cast<std::size_t>(f.cut)] : nullptr;
     j["cut_time_s"] = cs ? nlohmann::ordered_json(cs->time_s) : nlohmann::ordered_json();
     nlohmann::ordered_json a;
     if (f.kind == "cylinder") {
@@ -264,13 +271,28 @@ void writeTestPieceTruth(const TestPieceTruth& t, nlohmann::ordered_json& jt) {
       for (int k = 0; k < 7; ++k) m[names[k]] = cs->location[static_cast<std::size_t>(k)];
       m["tool_um"] = vec(cs->tool_um);
       m["part_above_20C_K"] = cs->part_above_20C_K;
+      m["feed_mm_per_min"] = cs->feed_mm_per_min;
+      m["spindle_rpm"] = cs->spindle_rpm;
+      m["deflection_um"] = vec(cs->deflection_um);
+      m["axes_um"] = {vec(cs->axes_start_um), vec(cs->axes_end_um)};
       j["machine"] = m;
     } else {
       j["machine"] = nullptr;
     }
     features.push_back(j);
   }
-  jt["features"] = features;
+  return features;
+}
+
+}  // namespace
+
+void writeTestPieceTruth(const TestPieceTruth& t, nlohmann::ordered_json& jt) {
+  jt["test_piece_note"] =
+      "features[].as_cut: the surface as cut, sampled exactly and fitted by least squares (part frame, 20 C, what a "
+      "perfect CMM finds); d_mm/depth_mm/beta_urad in datum_frame (seed 004 L2055); machine: the state when the cut "
+      "that made it started; ttp_cycles: seed 004 Eqs. 7.1-7.5 (7.1/7.2 sign corrected), ETTP_um = Eq. 7.3, "
+      "ETTP_7_9_um = Eq. 7.9, against cycle 0 (docs/simulator.md 3.1)";
+  jt["features"] = featuresJson(t.features, t.cuts);
   const auto& d = t.datum;
   if (d.found)
     jt["datum_frame"] = {{"origin_mm", vec(d.origin_mm)}, {"x", vec(d.x)}, {"y", vec(d.y)}, {"z", vec(d.z)}};
@@ -303,6 +325,23 @@ void writeTestPieceTruth(const TestPieceTruth& t, nlohmann::ordered_json& jt) {
     cycles.push_back(j);
   }
   jt["ttp_cycles"] = cycles;
+}
+
+std::vector<AsCutFeature> asCutFeatures(const parts::TestPiece& piece, const Stock& stock) {
+  std::vector<AsCutFeature> out;
+  for (const auto& f : piece.features) out.push_back(asCut(f, stock));
+  return out;
+}
+
+void writeAsCutFeatures(const std::vector<AsCutFeature>& features, const std::vector<CutState>& cuts,
+                        nlohmann::ordered_json& jt) {
+  jt["test_piece_note"] =
+      "features[].as_cut: the surface as cut, sampled exactly and fitted by least squares (part frame, 20 C, what a "
+      "perfect CMM finds); machine: the state when the cut that made most of it started (tool_um: thermal and static "
+      "tool drift; deflection_um: the tool pushed from the material, workpiece frame; axes_um: the linear axes' "
+      "geometric error at the cut's start and end); events[].axes_um: the same at each probe contact "
+      "(docs/simulator.md 3.2)";
+  jt["features"] = featuresJson(features, cuts);
 }
 
 }  // namespace probeloop::sim

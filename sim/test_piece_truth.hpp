@@ -48,6 +48,11 @@ struct CutState {
   std::array<double, 7> location{};                   // EX0C_um ... EC0C_urad
   Eigen::Vector3d tool_um = Eigen::Vector3d::Zero();  // tool-side translation
   double part_above_20C_K = 0;  // the part's temperature above 20 °C (its expansion, and its support's)
+  // Line cuts: the tool pushed away from the material (workpiece frame, um; seed 000
+  // Eq. 3.16 + structure), and the linear axes' tool-side error at the cut's start and end.
+  Eigen::Vector3d deflection_um = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axes_start_um = Eigen::Vector3d::Zero(), axes_end_um = Eigen::Vector3d::Zero();
+  double feed_mm_per_min = 0, spindle_rpm = 0;
 };
 
 struct AsCutFeature {
@@ -93,5 +98,12 @@ TestPieceTruth testPieceTruth(const parts::TestPiece& piece, const Stock& stock,
 
 // Adds "features", "datum_frame" and "ttp_cycles" to truth.json.
 void writeTestPieceTruth(const TestPieceTruth& t, nlohmann::ordered_json& truth);
+
+// Any other machined test piece (the stepped workpiece, seed 000): every feature as cut
+// (the sampling and fit above) with the machine's state, deflection and axis errors of the
+// cut that made it; truth.json gets "features" (no datum frame, no cycles).
+std::vector<AsCutFeature> asCutFeatures(const parts::TestPiece& piece, const Stock& stock);
+void writeAsCutFeatures(const std::vector<AsCutFeature>& features, const std::vector<CutState>& cuts,
+                        nlohmann::ordered_json& truth);
 
 }  // namespace probeloop::sim

@@ -84,6 +84,9 @@ struct ProbeEvent {
   std::array<double, 7> apparent{};  // what a sphere evaluation sees (docs/simulator.md)
   double pretravel_um = 0, noise_um = 0;
   Vector3d reported_tip_mm = Vector3d::Zero();  // latched, machine coordinates of the tip
+  // Workpiece probing: the tool-side error of the linear axes (geometric errors and
+  // squareness, not the drift) at the contact; what a CMM - probe comparison sees.
+  std::optional<Vector3d> axes_um;
 };
 
 class VirtualMachine : public gcode::MachineInterface {
@@ -350,6 +353,18 @@ class VirtualMachine : public gcode::MachineInterface {
       if (fanuc) streamFor("dprnt.txt");
       else newStream("controller.log");
     }
+  }
+
+  // The machine switched off for s seconds between programs (seed 000 L992: 3 h off before
+  // machining and before probing): spindle, coolant and axes still, the structure cooling
+  // toward the hall; no load from the duty profile (that runs only while a program dwells).
+  void machineOff(double s) {
+    spindle_rpm_ = 0;
+    coolant_ = false;
+    path_speed_mm_per_min_ = 0;
+    const double t0 = t_;
+    advance(s);
+    traceRow("machine_off", pos_, 0, t0);
   }
 
   // --- results --------------------------------------------------------------------------
@@ -641,6 +656,9 @@ class VirtualMachine : public gcode::MachineInterface {
     return d;
   }
 
+  // The part of toolError that the linear axes' geometric errors and squareness make (um).
+  Vector3d axesErrorUm(const Vector3d& gauge) const { return toolError(gauge) * 1e3 - toolDriftUm(); }
+
   Vector3d tipActual(const Vector3d& gauge) const {
     return gauge - Vector3d(0, 0, currentToolLength()) + toolError(gauge);
   }
@@ -923,7 +941,11 @@ class VirtualMachine : public gcode::MachineInterface {
     const Vector3d a = pos_.xyz_mm, b = to.xyz_mm;
     if (to.c_deg != pos_.c_deg && a != b) checkTogetherWithC(to, what);
     const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / 0.5)));
-    for (int k = 0; k <= n; ++k) {
+    // Straight up from where the tool stands: its start is where the last feed move left it,
+    // resting on (and, with axis errors that vary along X/Y, by a fraction of a micrometre in)
+    // the floor that neighbouring passes cut; rising, the same footprint only leaves material.
+    const bool straight_up = b.z() > a.z() && b.head<2>() == a.head<2>() && to.c_deg == pos_.c_deg;
+    for (int k = straight_up ? 1 : 0; k <= n; ++k) {
       const Vector3d g = a + (b - a) * (static_cast<double>(k) / n);
       const Vector3d tip = tipActual(g);
       if (tip.z() - (tool_ == m_.probe.tool ? tipRadius() : 0.0) < m_.table_surface_z_mm - 1e-9)
@@ -972,8 +994,16 @@ class VirtualMachine : public gcode::MachineInterface {
   }
 
   // The machine's state when a cut starts (truth.json relates the as-cut surfaces to it).
-  void recordCutState() {
+  void recordCutState(const Vector3d& deflection_mm = Vector3d::Zero(), const Vector3d* from = nullptr,
+                      const Vector3d* to = nullptr, double feed = 0) {
     CutState s;
+    s.deflection_um = deflection_mm * 1e3;
+    if (from && to) {
+      s.axes_start_um = axesErrorUm(*from);
+      s.axes_end_um = axesErrorUm(*to);
+    }
+    s.feed_mm_per_min = feed;
+    s.spindle_rpm = spindle_rpm_;
     s.time_s = t_;
     s.tool = tool_;
     s.location = locationErrors();
@@ -1035,7 +1065,7 @@ class VirtualMachine : public gcode::MachineInterface {
       e["moves"] = e["moves"].get<long>() + 1;
       e["until_s"] = t_ + dt;
     } else {
-      recordCutState();
+      recordCutState(defl, &pos_.xyz_mm, &to.xyz_mm, F);
       const Vector3d drift = toolDriftUm();
       cuts_.push_back({{"time_s", t_}, {"tool", tool_},
                        {"p0_mm", {w0.x() + defl.x(), w0.y() + defl.y(), w0.z()}},
@@ -1043,6 +1073,10 @@ class VirtualMachine : public gcode::MachineInterface {
                        {"radius_mm", r_w}, {"removed_mm3", rem.volume_mm3}, {"Ft_N", Ft}, {"Fn_N", Fn},
                        {"deflection_um", {defl.x() * 1e3, defl.y() * 1e3}},
                        {"tool_drift_um", {drift.x(), drift.y(), drift.z()}}});
+      if (tr_.axes.any || tr_.EC0Y_urad != 0 || tr_.EB0Z_urad != 0 || tr_.EA0Z_urad != 0) {
+        const Vector3d a0 = axesErrorUm(pos_.xyz_mm), a1 = axesErrorUm(to.xyz_mm);
+        cuts_.back()["axes_um"] = {{a0.x(), a0.y(), a0.z()}, {a1.x(), a1.y(), a1.z()}};
+      }
     }
     const double t0 = t_;
     move(dt, F);
@@ -1145,6 +1179,7 @@ class VirtualMachine : public gcode::MachineInterface {
     ProbeEvent ev = newEvent(dir, pre_um);
     ev.location = locationErrors();
     ev.tool_um = toolDriftUm();
+    ev.axes_um = axesErrorUm(pos_.xyz_mm + dir * s_contact);
     ev.atc_um = atc_um_;
     ev.settling_um = settlingUm();
     ev.artifact_dT_K = nodeRise(tr_.artifact.node);
@@ -1226,7 +1261,7 @@ gcode::ProgramDialect dialectOf(const std::string& program_file, const parts::Ma
 SimulationOutputs simulateProgram(const std::string& program_file, const std::string& text,
                                   const parts::Machine& machine, const SimulationPart& part,
                                   const MachineTruth& truth, std::uint64_t seed) {
-  return simulatePrograms({{program_file, text}}, machine, part, truth, seed);
+  return simulatePrograms({{program_file, text, std::nullopt}}, machine, part, truth, seed);
 }
 
 SimulationOutputs simulatePrograms(const std::vector<ProgramSource>& programs, const parts::Machine& machine,
@@ -1266,6 +1301,7 @@ SimulationOutputs simulatePrograms(const std::vector<ProgramSource>& programs, c
     const gcode::ProgramDialect dialect = dialectOf(p.file, machine);
     last_fanuc = dialect == gcode::ProgramDialect::FanucMacroB;
     gcode::Interpreter interp(dialect, p.file, p.text);
+    if (p.start_s && *p.start_s > vm.time()) vm.machineOff(*p.start_s - vm.time());
     vm.beginProgram(p.file, last_fanuc);
     const auto run = interp.run(vm);
     vm.endProgram();
@@ -1357,6 +1393,7 @@ SimulationOutputs simulatePrograms(const std::vector<ProgramSource>& programs, c
     je["artifact_dT_K"] = e.artifact_dT_K;
     je["pretravel_um"] = e.pretravel_um;
     je["noise_um"] = e.noise_um;
+    if (e.axes_um) je["axes_um"] = {e.axes_um->x(), e.axes_um->y(), e.axes_um->z()};
     for (int j = 0; j < 7; ++j) je[std::string("apparent_") + names[j]] = e.apparent[j];
     jt["events"].push_back(je);
     auto& acc = per_cycle[p.cycle];
@@ -1378,6 +1415,8 @@ SimulationOutputs simulatePrograms(const std::vector<ProgramSource>& programs, c
   if (given.test_piece && given.test_piece->thermalTestPiece() && part.workpiece) {
     const auto t = testPieceTruth(*given.test_piece, vm.stock(), vm.cutStates());
     writeTestPieceTruth(t, jt);
+  } else if (given.test_piece && part.workpiece) {
+    writeAsCutFeatures(asCutFeatures(*given.test_piece, vm.stock()), vm.cutStates(), jt);
   }
   out.points_csv = csv.str();
   out.truth_json = jt.dump(1) + "\n";

@@ -36,6 +36,7 @@
 // program through simulatePrograms gives what simulateProgram gives.
 #pragma once
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -97,6 +98,10 @@ SimulationOutputs simulateProgram(const std::string& program_file, const std::st
 struct ProgramSource {
   std::string file;  // its name decides the dialect (.ngc LinuxCNC, .nc/.tap Fanuc, else the machine's)
   std::string text;
+  // Planned start on the run's clock (the plan manifest's programs[].start_s): when the
+  // previous program ended earlier, the machine is off until then (MachineTruth's thermal
+  // network cools); when later, the program starts at once. Absent: back to back.
+  std::optional<double> start_s = std::nullopt;
 };
 SimulationOutputs simulatePrograms(const std::vector<ProgramSource>& programs, const parts::Machine& machine,
                                    const SimulationPart& part, const MachineTruth& truth, std::uint64_t seed);

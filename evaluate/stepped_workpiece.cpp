@@ -1,0 +1,391 @@
+#include "evaluate/stepped_workpiece.hpp"
+
+#include <cmath>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "core/csv.hpp"
+#include "core/error.hpp"
+#include "evaluate/budget_json.hpp"
+#include "geometry/fit.hpp"
+
+namespace probeloop::evaluate {
+
+using Eigen::Vector3d;
+using uncertainty::Budget;
+using uncertainty::Contribution;
+
+namespace {
+
+constexpr double kSqrt3 = 1.7320508075688772;
+// On the machine the part's temperature is not measured: within 20 C +- this (our assumption,
+// docs/stepped-workpiece.md §6; the thesis's hall is not stated).
+constexpr double kMachinePartHalfWidthK = 1.0;
+
+std::string stepId(int k, const char* face) { return "S" + std::to_string(k) + "_" + face; }
+
+const SwPlane& plane(const SwSourceGeometry& g, const std::string& id) {
+  for (const auto& p : g.planes)
+    if (p.id == id) return p;
+  throw InputError(g.file, 0, "feature " + id + ": no points measured (the manifest plans it)");
+}
+
+// The plane's coordinate along axis a (0 x, 1 y, 2 z) at the other two coordinates of q.
+double onPlane(const SwPlane& p, int a, const Vector3d& q, const std::string& file) {
+  if (!(std::fabs(p.normal(a)) > 0.5))
+    throw GeometryError(file + ": feature " + p.id + ": its plane is not square to axis " + "xyz"[a] +
+                        " (normal " + formatNumber(p.normal.x(), 4) + ", " + formatNumber(p.normal.y(), 4) + ", " +
+                        formatNumber(p.normal.z(), 4) + ")");
+  double s = 0;
+  for (int i = 0; i < 3; ++i)
+    if (i != a) s += p.normal(i) * (q(i) - p.point_mm(i));
+  return p.point_mm(a) - s / p.normal(a);
+}
+
+double slope(const SwPlane& p, int along, int over) { return -p.normal(over) / p.normal(along); }
+
+Contribution contribution(std::string input, char type, std::string dist, std::string basis, double u,
+                          double dof = std::numeric_limits<double>::infinity()) {
+  Contribution c;
+  c.input = std::move(input);
+  c.type = type;
+  c.distribution = std::move(dist);
+  c.basis = std::move(basis);
+  c.u = u;
+  c.dof = dof;
+  return c;
+}
+
+}  // namespace
+
+SwSourceGeometry steppedGeometry(const parts::PlanManifest& m, const TtpPoints& pts, const std::string& route) {
+  SwSourceGeometry g;
+  g.file = pts.file;
+  g.route = route;
+  // Repeated touches of one planned point (step 3's walls, L769) are averaged: the fit takes
+  // each place once (points of a feature closer than 0.05 mm are one place; planned points are
+  // millimetres apart).
+  std::map<std::string, std::vector<std::pair<Vector3d, int>>> sums;
+  for (const auto& p : pts.points) {
+    auto& v = sums[p.feature];
+    bool merged = false;
+    for (auto& [s, n] : v)
+      if ((s / n - p.p_mm).norm() < 0.05) {
+        s += p.p_mm;
+        ++n;
+        merged = true;
+        break;
+      }
+    if (!merged) v.push_back({p.p_mm, 1});
+  }
+  std::map<std::string, geometry::Points3> by_feature;
+  for (const auto& [f, v] : sums)
+    for (const auto& [s, n] : v) by_feature[f].push_back(s / n);
+  for (const auto& f : m.features) {
+    const auto& nf = f.nominal;
+    if (nf.kind != "plane") continue;
+    const auto it = by_feature.find(nf.id);
+    if (it == by_feature.end()) continue;
+    if (it->second.size() < 3)
+      throw InputError(pts.file, 0, "feature " + nf.id + ": " + std::to_string(it->second.size()) +
+                                        " points, a plane needs at least 3");
+    SwPlane p;
+    p.id = nf.id;
+    p.role = nf.role;
+    p.points = static_cast<int>(it->second.size());
+    try {
+      const auto fit = geometry::fitElement(geometry::ElementKind::Plane, it->second, {});
+      p.point_mm = fit.fit.element.position_mm;
+      p.normal = fit.fit.element.direction.normalized();
+    } catch (const std::exception& e) {
+      throw InputError(pts.file, 0, "feature " + nf.id + ": no plane through its points: " + e.what());
+    }
+    if (p.normal.dot(nf.direction) < 0) p.normal = -p.normal;
+    double ss = 0;
+    for (const auto& q : it->second) ss += std::pow(p.normal.dot(q - p.point_mm), 2);
+    p.rms_um = std::sqrt(ss / std::max(1, p.points - 3)) * 1e3;  // s of the residuals (3 parameters)
+    g.planes.push_back(p);
+  }
+  const SwPlane& top = plane(g, "TOP");
+  for (std::size_t i = 0; i < m.sw.sizes_mm.size(); ++i) {
+    const int k = static_cast<int>(i) + 1;
+    SwStepGeometry s;
+    s.step = k;
+    s.size_mm = m.sw.sizes_mm[i];
+    const auto* fxp = m.feature(stepId(k, "XP"));
+    const auto* ffl = m.feature(stepId(k, "F"));
+    if (!fxp || !ffl) throw InputError(m.file, 0, "features: step " + std::to_string(k) + " has no walls or floor");
+    s.depth_nominal_mm = -ffl->nominal.point_mm.z();
+    const SwPlane &xp = plane(g, stepId(k, "XP")), &xn = plane(g, stepId(k, "XN")), &yp = plane(g, stepId(k, "YP")),
+                  &yn = plane(g, stepId(k, "YN")), &fl = plane(g, stepId(k, "F"));
+    // The step's centre line at its walls' mid-height.
+    const Vector3d c(0.5 * (xp.point_mm.x() + xn.point_mm.x()), 0.5 * (yp.point_mm.y() + yn.point_mm.y()),
+                     fxp->nominal.point_mm.z());
+    s.width_x_mm = onPlane(xp, 0, c, g.file) - onPlane(xn, 0, c, g.file);
+    s.width_y_mm = onPlane(yp, 1, c, g.file) - onPlane(yn, 1, c, g.file);
+    s.u_wall_x_um = std::hypot(xp.rms_um / std::sqrt(xp.points), xn.rms_um / std::sqrt(xn.points));
+    s.u_wall_y_um = std::hypot(yp.rms_um / std::sqrt(yp.points), yn.rms_um / std::sqrt(yn.points));
+    Vector3d fc = Vector3d::Zero();
+    int nf = 0;
+    for (const auto& p : pts.points)
+      if (p.feature == fl.id) fc += p.p_mm, ++nf;
+    fc /= nf;
+    s.depth_mm = onPlane(top, 2, fc, g.file) - onPlane(fl, 2, fc, g.file);
+    s.u_depth_um = std::hypot(top.rms_um / std::sqrt(top.points), fl.rms_um / std::sqrt(fl.points));
+    s.lean_x_urad = 0.5 * (slope(xp, 0, 2) + slope(xn, 0, 2)) * 1e6;
+    s.lean_y_urad = 0.5 * (slope(yp, 1, 2) + slope(yn, 1, 2)) * 1e6;
+    s.floor_slope_x_urad = slope(fl, 2, 0) * 1e6;
+    s.floor_slope_y_urad = slope(fl, 2, 1) * 1e6;
+    Vector3d nx = xp.normal - xn.normal, ny = yp.normal - yn.normal;
+    nx.z() = 0;
+    ny.z() = 0;
+    s.oz_urad = -std::asin(nx.normalized().dot(ny.normalized())) * 1e6;
+    g.steps.push_back(s);
+  }
+  return g;
+}
+
+SwRepeatability probeRepeatability(const parts::PlanManifest& m, const TtpPoints& probe) {
+  // (feature, point) -> nominal contact and approach
+  std::map<std::pair<std::string, int>, const parts::ManifestPoint*> plan;
+  for (const auto& p : m.points) plan[{p.feature, p.point}] = &p;
+  std::map<std::string, std::vector<std::pair<const parts::ManifestPoint*, Vector3d>>> seen;
+  SwRepeatability r;
+  double ss = 0;
+  for (const auto& p : probe.points) {
+    const auto it = plan.find({p.feature, p.point});
+    if (it == plan.end()) continue;
+    for (const auto& [q, x] : seen[p.feature])
+      if ((q->contact_mm - it->second->contact_mm).norm() < 1e-6) {
+        ss += std::pow(it->second->approach.normalized().dot(p.p_mm - x), 2);
+        ++r.pairs;
+      }
+    seen[p.feature].push_back({it->second, p.p_mm});
+  }
+  if (r.pairs > 0) r.s_um = std::sqrt(ss / (2.0 * r.pairs)) * 1e3;
+  return r;
+}
+
+SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoints& cmm, const TtpPoints& probe) {
+  if (m.kind != "stepped_workpiece")
+    throw InputError(m.file, 0, "kind: '" + m.kind + "': the stepped-workpiece evaluation needs a stepped_workpiece plan");
+  SwEvaluation e;
+  e.experiment = m.sw.experiment;
+  e.cmm = steppedGeometry(m, cmm, "cmm");
+  e.probe = steppedGeometry(m, probe, "on_machine");
+  const auto rep = probeRepeatability(m, probe);
+  e.probe_repeat_pairs = rep.pairs;
+  const bool type_a = rep.pairs >= 2;
+  const double s_pt = type_a ? rep.s_um : m.probe_repeatability_2sigma_um / 2;
+  const double dof_pt = type_a ? rep.pairs : std::numeric_limits<double>::infinity();
+  e.probe_repeatability_um = s_pt;
+  const std::string rep_basis =
+      type_a ? std::to_string(rep.pairs) + " repeated points: s = " + formatNumber(s_pt, 3) + " um"
+             : "no repeated points: the manifest's probe repeatability 2 sigma " + formatNumber(m.probe_repeatability_2sigma_um) + " um";
+  const double alpha = m.material_alpha_um_per_m_K * 1e-3;  // um per mm per K
+  const double dT_cmm = m.sw.cmm.temperature_half_width_K;
+  auto mpe = [&](double L) { return m.sw.cmm.mpe_constant_um + (m.sw.cmm.mpe_length_mm > 0 ? L / m.sw.cmm.mpe_length_mm : 0.0); };
+  const double d_probe = 2 * m.tip_radius_mm, d_tool = m.sw.tool_diameter_mm;
+  auto count = [](const SwSourceGeometry& g, const std::string& id) { return plane(g, id).points; };
+
+  std::vector<std::array<Budget, 3>> pos;  // per step: x, y, z
+  for (std::size_t i = 0; i < e.probe.steps.size(); ++i) {
+    const auto &c = e.cmm.steps[i], &p = e.probe.steps[i];
+    const int k = c.step;
+    std::array<Budget, 3> b;
+    const char* axes[3] = {"x", "y", "z"};
+    for (int a = 0; a < 3; ++a) {
+      const double value = a == 0 ? c.width_x_error_um() - p.width_x_error_um()
+                           : a == 1 ? c.width_y_error_um() - p.width_y_error_um()
+                                    : c.depth_error_um() - p.depth_error_um();
+      const double L = a < 2 ? c.size_mm : c.depth_nominal_mm;
+      const int n1 = a == 0 ? count(e.probe, stepId(k, "XP")) : a == 1 ? count(e.probe, stepId(k, "YP")) : count(e.probe, "TOP");
+      const int n2 = a == 0 ? count(e.probe, stepId(k, "XN")) : a == 1 ? count(e.probe, stepId(k, "YN")) : count(e.probe, stepId(k, "F"));
+      const double u_fit_cmm = a == 0 ? c.u_wall_x_um : a == 1 ? c.u_wall_y_um : c.u_depth_um;
+      std::vector<Contribution> cs{
+          contribution("probe repeatability", type_a ? 'A' : 'B', "normal", rep_basis, s_pt * std::sqrt(1.0 / n1 + 1.0 / n2), dof_pt),
+          contribution("CMM length measurement", 'B', "rectangular", "MPE " + formatNumber(mpe(L), 3) + " um at " + formatNumber(L) + " mm",
+                       mpe(L) / kSqrt3),
+          contribution("CMM plane fits", 'A', "normal", "s of the residuals / sqrt(n) of both planes", u_fit_cmm,
+                       std::max(1, count(e.cmm, a == 2 ? "TOP" : stepId(k, a == 0 ? "XP" : "YP")) - 3)),
+          contribution("part temperature at the CMM", 'B', "rectangular",
+                       "20 C +- " + formatNumber(dT_cmm) + " K, not corrected", alpha * L * dT_cmm / kSqrt3),
+          contribution("part temperature on the machine", 'B', "rectangular",
+                       "20 C +- " + formatNumber(kMachinePartHalfWidthK) + " K (not measured)", alpha * L * kMachinePartHalfWidthK / kSqrt3)};
+      b[a] = uncertainty::combine(std::string("e_pos_") + axes[a] + "_um", "um", value, cs);
+    }
+    pos.push_back(b);
+  }
+  // e_pos(L) = k L per axis, weighted by 1/u_c^2; u(k) from the weights, scaled up by the
+  // Birge ratio when the steps scatter more than their budgets allow.
+  Budget* kb[3] = {&e.k_pos_x_um_per_mm, &e.k_pos_y_um_per_mm, &e.k_pos_z_um_per_mm};
+  for (int a = 0; a < 3; ++a) {
+    double swl2 = 0, swle = 0;
+    std::vector<std::pair<double, double>> le;
+    for (std::size_t i = 0; i < pos.size(); ++i) {
+      const double L = a < 2 ? e.probe.steps[i].size_mm - d_probe : e.probe.steps[i].depth_nominal_mm;
+      const double w = 1.0 / std::pow(pos[i][a].u_c, 2);
+      swl2 += w * L * L;
+      swle += w * L * pos[i][a].value;
+      le.push_back({L, pos[i][a].value});
+    }
+    const double k = swle / swl2;
+    double chi2 = 0;
+    for (std::size_t i = 0; i < le.size(); ++i) chi2 += std::pow(le[i].second - k * le[i].first, 2) / std::pow(pos[i][a].u_c, 2);
+    const int dof = static_cast<int>(le.size()) - 1;
+    const double birge = dof > 0 ? std::max(1.0, std::sqrt(chi2 / dof)) : 1.0;
+    *kb[a] = uncertainty::combine(std::string("k_pos_") + "xyz"[a] + "_um_per_mm", "um/mm", k,
+                                  {contribution("e_pos of the steps", 'A', "normal",
+                                                "weighted line through 0 over " + std::to_string(le.size()) + " steps, Birge ratio " +
+                                                    formatNumber(birge, 3),
+                                                birge / std::sqrt(swl2), std::max(1, dof))});
+  }
+  for (std::size_t i = 0; i < e.probe.steps.size(); ++i) {
+    const auto& p = e.probe.steps[i];
+    const int k = p.step;
+    SwStepSeparation s;
+    s.step = k;
+    if (i < m.sw.steps.size()) {
+      s.feed_mm_per_min = m.sw.steps[i].feed_xy_mm_per_min;
+      s.spindle_rpm = m.sw.steps[i].spindle_speed_rpm;
+      s.temp_state_min = m.sw.steps[i].temp_state_min;
+    }
+    s.travel_probe_mm = p.size_mm - d_probe;
+    s.travel_tool_mm = p.size_mm + d_tool;
+    s.e_pos_x_um = pos[i][0];
+    s.e_pos_y_um = pos[i][1];
+    s.e_pos_z_um = pos[i][2];
+    for (int a = 0; a < 2; ++a) {
+      const double we = a == 0 ? p.width_x_error_um() : p.width_y_error_um();
+      const Budget& kk = *kb[a];
+      const double lever = d_tool + d_probe;  // e_pos over the tool's travel minus over the probe's
+      const int n1 = count(e.probe, stepId(k, a == 0 ? "XP" : "YP")), n2 = count(e.probe, stepId(k, a == 0 ? "XN" : "YN"));
+      std::vector<Contribution> cs{
+          contribution("probe repeatability", type_a ? 'A' : 'B', "normal", rep_basis, s_pt * std::sqrt(1.0 / n1 + 1.0 / n2), dof_pt),
+          contribution("e_pos slope k", 'A', "normal", "u(k) x (tool d + stylus d) = " + formatNumber(lever) + " mm", kk.u_c * lever,
+                       kk.contributions.empty() ? 1 : kk.contributions.front().dof),
+          contribution("part temperature on the machine", 'B', "rectangular",
+                       "20 C +- " + formatNumber(kMachinePartHalfWidthK) + " K (not measured)", alpha * p.size_mm * kMachinePartHalfWidthK / kSqrt3)};
+      (a == 0 ? s.e_proc_x_um : s.e_proc_y_um) =
+          uncertainty::combine(std::string("e_proc_") + "xy"[a] + "_um", "um", we - kk.value * lever, cs);
+    }
+    const int nt = count(e.probe, "TOP"), nf = count(e.probe, stepId(k, "F"));
+    s.e_splz_um = uncertainty::combine(
+        "e_splz_um", "um", -p.depth_error_um(),
+        {contribution("probe repeatability", type_a ? 'A' : 'B', "normal", rep_basis, s_pt * std::sqrt(1.0 / nt + 1.0 / nf), dof_pt),
+         contribution("e_pos_z over the depth", 'A', "normal", "u(k_z) x depth", e.k_pos_z_um_per_mm.u_c * p.depth_nominal_mm,
+                      e.k_pos_z_um_per_mm.contributions.front().dof),
+         contribution("part temperature on the machine", 'B', "rectangular",
+                      "20 C +- " + formatNumber(kMachinePartHalfWidthK) + " K (not measured)",
+                      alpha * p.depth_nominal_mm * kMachinePartHalfWidthK / kSqrt3)});
+    e.steps.push_back(s);
+  }
+  e.notes.push_back("e_proc: the thermal position error of X and Y (Eq. 3.5/3.6) needs a campaign at constant feed "
+                    "(W1, W6, W7); from one workpiece it is taken as 0 and e_proc holds it");
+  e.notes.push_back("e_splz: the depth error of each floor below the top, from the probe (+ = the floor shallower: the tool "
+                    "tip rose between the top's cut and the floor's); e_pos_z is removed by the probe route itself");
+  e.notes.push_back("the part's temperature is not corrected on either route; its range is in every budget");
+  return e;
+}
+
+namespace {
+std::string num(double v, int d = 4) { return formatNumber(v, d); }
+}  // namespace
+
+std::string swErrorsCsv(const SwEvaluation& e) {
+  std::ostringstream o;
+  o << "# probeloop evaluate: stepped workpiece " << e.experiment << " (seed 000); components in um, U with k = 2\n";
+  o << "step,feed_mm_per_min,spindle_rpm,temp_state_min,travel_probe_mm,travel_tool_mm";
+  const char* names[] = {"e_pos_x_um", "e_pos_y_um", "e_pos_z_um", "e_proc_x_um", "e_proc_y_um", "e_splz_um"};
+  for (const char* n : names) o << "," << n << ",u_" << n << ",U_" << n;
+  o << "\n";
+  for (const auto& s : e.steps) {
+    o << s.step << "," << num(s.feed_mm_per_min, 1) << "," << num(s.spindle_rpm, 0) << "," << num(s.temp_state_min, 3) << ","
+      << num(s.travel_probe_mm, 3) << "," << num(s.travel_tool_mm, 3);
+    for (const Budget* b : {&s.e_pos_x_um, &s.e_pos_y_um, &s.e_pos_z_um, &s.e_proc_x_um, &s.e_proc_y_um, &s.e_splz_um})
+      o << "," << num(b->value, 3) << "," << num(b->u_c, 3) << "," << num(b->U, 3);
+    o << "\n";
+  }
+  return o.str();
+}
+
+std::string swEvaluationJson(const SwEvaluation& e) {
+  nlohmann::ordered_json j;
+  j["format"] = "probeloop-evaluation";
+  j["kind"] = "stepped_workpiece";
+  j["experiment"] = e.experiment;
+  auto geom = [](const SwSourceGeometry& g) {
+    nlohmann::ordered_json s{{"file", g.file}, {"route", g.route}};
+    for (const auto& p : g.planes)
+      s["planes"].push_back({{"id", p.id}, {"role", p.role}, {"points", p.points},
+                             {"point_mm", {p.point_mm.x(), p.point_mm.y(), p.point_mm.z()}},
+                             {"normal", {p.normal.x(), p.normal.y(), p.normal.z()}}, {"residual_s_um", p.rms_um}});
+    for (const auto& t : g.steps)
+      s["steps"].push_back({{"step", t.step}, {"size_mm", t.size_mm}, {"width_x_mm", t.width_x_mm}, {"width_y_mm", t.width_y_mm},
+                            {"depth_nominal_mm", t.depth_nominal_mm}, {"depth_mm", t.depth_mm},
+                            {"width_x_error_um", t.width_x_error_um()}, {"width_y_error_um", t.width_y_error_um()},
+                            {"depth_error_um", t.depth_error_um()}, {"wall_tilt_x_urad", t.lean_x_urad},
+                            {"wall_tilt_y_urad", t.lean_y_urad}, {"floor_slope_x_urad", t.floor_slope_x_urad},
+                            {"floor_slope_y_urad", t.floor_slope_y_urad}, {"oz_urad", t.oz_urad}});
+    return s;
+  };
+  j["cmm"] = geom(e.cmm);
+  j["on_machine"] = geom(e.probe);
+  j["probe_repeatability_um"] = e.probe_repeatability_um;
+  j["probe_repeat_pairs"] = e.probe_repeat_pairs;
+  j["k_pos_x_um_per_mm"] = budgetJson(e.k_pos_x_um_per_mm);
+  j["k_pos_y_um_per_mm"] = budgetJson(e.k_pos_y_um_per_mm);
+  j["k_pos_z_um_per_mm"] = budgetJson(e.k_pos_z_um_per_mm);
+  for (const auto& s : e.steps)
+    j["separation"].push_back({{"step", s.step}, {"feed_mm_per_min", s.feed_mm_per_min}, {"spindle_rpm", s.spindle_rpm},
+                               {"temp_state_min", s.temp_state_min}, {"travel_probe_mm", s.travel_probe_mm},
+                               {"travel_tool_mm", s.travel_tool_mm}, {"e_pos_x_um", budgetJson(s.e_pos_x_um)},
+                               {"e_pos_y_um", budgetJson(s.e_pos_y_um)}, {"e_pos_z_um", budgetJson(s.e_pos_z_um)},
+                               {"e_proc_x_um", budgetJson(s.e_proc_x_um)}, {"e_proc_y_um", budgetJson(s.e_proc_y_um)},
+                               {"e_splz_um", budgetJson(s.e_splz_um)}});
+  j["notes"] = e.notes;
+  return j.dump(1) + "\n";
+}
+
+std::string swReport(const SwEvaluation& e) {
+  std::ostringstream o;
+  o << "# Stepped workpiece " << e.experiment << ": geometry and separated errors\n\n";
+  o << "Seed 000 (Yaqoob 2017) Ch. 5 from one workpiece; docs/stepped-workpiece.md §6. U with k = 2.\n\n";
+  o << "## Geometry\n\n| step | route | width X err um | width Y err um | depth err um | wall tilt X urad | wall tilt Y urad | "
+       "floor slope X urad | floor slope Y urad | Oz urad |\n|---|---|---|---|---|---|---|---|---|---|\n";
+  for (const auto* g : {&e.cmm, &e.probe})
+    for (const auto& s : g->steps)
+      o << "| " << s.step << " | " << g->route << " | " << num(s.width_x_error_um(), 2) << " | " << num(s.width_y_error_um(), 2) << " | "
+        << num(s.depth_error_um(), 2) << " | " << num(s.lean_x_urad, 1) << " | " << num(s.lean_y_urad, 1) << " | "
+        << num(s.floor_slope_x_urad, 1) << " | " << num(s.floor_slope_y_urad, 1) << " | " << num(s.oz_urad, 1) << " |\n";
+  o << "\n## Separated components (um)\n\n| step | feed mm/min | T min | e_pos_x | e_pos_y | e_pos_z | e_proc_x (2 walls) | "
+       "e_proc_y (2 walls) | e_splz |\n|---|---|---|---|---|---|---|---|---|\n";
+  auto bu = [](const Budget& b) { return num(b.value, 2) + " ± " + num(b.U, 2); };
+  for (const auto& s : e.steps)
+    o << "| " << s.step << " | " << num(s.feed_mm_per_min, 0) << " | " << num(s.temp_state_min, 1) << " | " << bu(s.e_pos_x_um) << " | "
+      << bu(s.e_pos_y_um) << " | " << bu(s.e_pos_z_um) << " | " << bu(s.e_proc_x_um) << " | " << bu(s.e_proc_y_um) << " | "
+      << bu(s.e_splz_um) << " |\n";
+  o << "\nPosition error per mm of travel: k_x = " << bu(e.k_pos_x_um_per_mm) << ", k_y = " << bu(e.k_pos_y_um_per_mm)
+    << ", k_z = " << bu(e.k_pos_z_um_per_mm) << " um/mm. Probe repeatability (1 sigma, one point): "
+    << num(e.probe_repeatability_um, 3) << " um from " << e.probe_repeat_pairs << " repeated points.\n\n";
+  for (const auto& n : e.notes) o << "- " << n << "\n";
+  return o.str();
+}
+
+std::string swStdout(const SwEvaluation& e, const std::string& out_dir) {
+  std::ostringstream o;
+  o << "Stepped workpiece " << e.experiment << ": " << e.cmm.planes.size() << " planes from the CMM, " << e.probe.planes.size()
+    << " from the probe; probe repeatability " << num(e.probe_repeatability_um, 2) << " um (" << e.probe_repeat_pairs
+    << " repeats)\n";
+  o << "  e_pos per mm: X " << num(e.k_pos_x_um_per_mm.value, 4) << " +- " << num(e.k_pos_x_um_per_mm.U, 4) << ", Y "
+    << num(e.k_pos_y_um_per_mm.value, 4) << " +- " << num(e.k_pos_y_um_per_mm.U, 4) << " um/mm (U, k = 2)\n";
+  for (const auto& s : e.steps)
+    o << "  step " << s.step << " (F " << num(s.feed_mm_per_min, 0) << ", T " << num(s.temp_state_min, 1) << " min): e_pos_x "
+      << num(s.e_pos_x_um.value, 2) << ", e_proc_x " << num(s.e_proc_x_um.value, 2) << " +- " << num(s.e_proc_x_um.U, 2)
+      << ", e_splz " << num(s.e_splz_um.value, 2) << " +- " << num(s.e_splz_um.U, 2) << " um\n";
+  o << "  wrote errors.csv, evaluation.json, report.md in " << out_dir << "\n";
+  return o.str();
+}
+
+}  // namespace probeloop::evaluate

@@ -1,0 +1,105 @@
+// Evaluating one stepped workpiece (seed 000, Yaqoob 2017 Ch. 5; docs/stepped-workpiece.md §6):
+// its CMM export and its on-machine probe log -> the geometry of every step and the error
+// components the thesis separates from one part, each with a GUM budget.
+//
+// Geometry (per source, CMM and probe): a least-squares plane per wall, floor and the top
+// (geometry::fitElement); per step the face-to-face widths X and Y at the wall's mid-height
+// (the planes evaluated at the step's centre line), the depth of its floor below the top (both
+// planes at the floor points' centroid), the walls' inclination dx/dz, dy/dz (the lean outward
+// positive), the floor's slopes dz/dx, dz/dy and Oz, the squareness of the X walls to the Y
+// walls (the angle between their normals minus 90 deg, positive when it is larger).
+//
+// Separation (both sources; seed 000 Sec. 3.3-3.6):
+// - e_pos (L761: CMM - probe): per step and axis, CMM width - probe width; it belongs to the
+//   distance the probe's centre travelled between the walls (size - stylus diameter, the
+//   thesis's "offset distance ... incorporated", L769). Z: CMM depth - probe depth, over the
+//   depth. A straight line through zero per axis, e_pos(L) = k L, weighted least squares.
+// - e_proc (L1629, a two-wall sum): probe width error - (e_pos over the tool centre's travel,
+//   size + tool diameter, minus e_pos over the probe's, size - stylus diameter) - the thermal
+//   position error, which one workpiece cannot separate: taken as 0 with its own budget line
+//   left to a W1 campaign (stated in the output). Per wall: half (L1639).
+// - e_splz (Sec. 3.5, L812): the floor's depth error from the probe: the spindle's growth
+//   between the top's cut and the floor's (+ when the floor lies shallower, i.e. the tool tip
+//   rose), with the cut times of the manifest.
+// Budgets: probe repeatability (from the repeated points, type A; else the manifest's 2 sigma,
+// type B), the CMM's MPE (rectangular), the part's temperature (CMM: the manifest's +-half
+// width; on the machine: +-1 K about 20 C, our assumption, rectangular), the planes' fit
+// residuals, and for e_proc the line's u(k).
+//
+// Contract: InputError (file, line, feature) for what cannot be read or a feature with fewer
+// than 3 points; GeometryError never escapes as a NaN: a degenerate plane is refused naming it.
+#pragma once
+#include <Eigen/Dense>
+#include <string>
+#include <vector>
+
+#include "evaluate/ttp_ingest.hpp"
+#include "parts/plan_manifest.hpp"
+#include "uncertainty/budget.hpp"
+
+namespace probeloop::evaluate {
+
+struct SwPlane {
+  std::string id, role;
+  int points = 0;
+  Eigen::Vector3d point_mm = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::UnitZ();  // outward
+  double rms_um = 0;
+};
+
+struct SwStepGeometry {
+  int step = 0;
+  double size_mm = 0, depth_nominal_mm = 0;
+  double width_x_mm = 0, width_y_mm = 0, depth_mm = 0;
+  double u_wall_x_um = 0, u_wall_y_um = 0, u_depth_um = 0;  // from the fits' residuals
+  double lean_x_urad = 0, lean_y_urad = 0;                  // mean outward lean of the X and Y walls
+  double floor_slope_x_urad = 0, floor_slope_y_urad = 0;    // dz/dx, dz/dy of the floor
+  double oz_urad = 0;
+  double width_x_error_um() const { return (width_x_mm - size_mm) * 1e3; }
+  double width_y_error_um() const { return (width_y_mm - size_mm) * 1e3; }
+  double depth_error_um() const { return (depth_mm - depth_nominal_mm) * 1e3; }
+};
+
+struct SwSourceGeometry {
+  std::string file, route;  // cmm | on_machine
+  std::vector<SwPlane> planes;
+  std::vector<SwStepGeometry> steps;
+};
+
+struct SwStepSeparation {
+  int step = 0;
+  double feed_mm_per_min = 0, spindle_rpm = 0, temp_state_min = 0;
+  double travel_probe_mm = 0, travel_tool_mm = 0;  // size - stylus d, size + tool d
+  uncertainty::Budget e_pos_x_um, e_pos_y_um, e_pos_z_um;
+  uncertainty::Budget e_proc_x_um, e_proc_y_um;  // two-wall sums (L1639: half per wall)
+  uncertainty::Budget e_splz_um;
+};
+
+struct SwEvaluation {
+  std::string experiment;
+  SwSourceGeometry cmm, probe;
+  double probe_repeatability_um = 0;  // 1 sigma per point
+  int probe_repeat_pairs = 0;         // 0: the manifest's specification was used
+  uncertainty::Budget k_pos_x_um_per_mm, k_pos_y_um_per_mm, k_pos_z_um_per_mm;
+  std::vector<SwStepSeparation> steps;
+  std::vector<std::string> notes;
+};
+
+SwSourceGeometry steppedGeometry(const parts::PlanManifest& m, const TtpPoints& points, const std::string& route);
+
+// The manifest's repeated probe points (same feature, same nominal contact): s of one point.
+struct SwRepeatability {
+  double s_um = 0;
+  int pairs = 0;
+};
+SwRepeatability probeRepeatability(const parts::PlanManifest& m, const TtpPoints& probe);
+
+SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoints& cmm, const TtpPoints& probe);
+
+// Outputs: errors.csv (one row per step: the components with u and U), evaluation.json,
+// report.md, and the stdout summary.
+std::string swErrorsCsv(const SwEvaluation& e);
+std::string swEvaluationJson(const SwEvaluation& e);
+std::string swReport(const SwEvaluation& e);
+std::string swStdout(const SwEvaluation& e, const std::string& out_dir);
+
+}  // namespace probeloop::evaluate
