@@ -120,18 +120,20 @@ eval "$cmd" > /dev/null
 probeloop model fit "$T/model.yaml" --report "$T/fit.html" > "$T/fit.txt"
 sed -n '/^Before -> after/,$p' "$T/fit.txt" | grep -E 'Before|channel|ETTP' | sed 's/^/   /'
 
-echo "== 8. the stepped workpiece (seed 000): the programs of experiment W8, each step's Temp state, W8 on the virtual VMC =="
+echo "== 8. the stepped workpiece (seed 000): the programs of W8, each step's Temp state, W8 on the virtual VMC, the separation =="
 S=$OUT/stepped
 $PL plan parts/stepped_workpiece.yaml --machine parts/machines/vmc3.yaml --out "$S/plan" --experiment W8 | sed 's/^/   /'
 $PL simulate "$S/plan/roughing.ngc" "$S/plan/finishing.ngc" "$S/plan/probing.ngc" --machine parts/machines/vmc3.yaml \
-  --part parts/stepped_workpiece.yaml --truth examples/truth_machining.yaml --cmm-points "$S/plan/cmm_points.csv" \
-  --out "$S/run" | sed 's/^/   /'
-echo "   (the error separation of the stepped workpiece comes next; the thesis's tables are reproduced by"
-echo "    evaluate/stepped_separation_test: docs/stepped-workpiece.md)"
+  --part parts/stepped_workpiece.yaml --truth examples/stepped_workpiece/truth.yaml --cmm-points "$S/plan/cmm_points.csv" \
+  --schedule "$S/plan/plan.json" --out "$S/run" | sed 's/^/   /'
+echo "-- CMM - probe, process and spindle errors per step (truth: 0.15 / 0.25 um/mm; the rest in $S/run/truth.json)"
+$PL evaluate "$S/run/cmm_export.csv" --probe-log "$S/run/sw_probe.log" --manifest "$S/plan/plan.json" --out "$S/eval" | sed 's/^/   /'
+echo "   (the thesis's tables are reproduced by evaluate/stepped_separation_test; the campaign, compensation"
+echo "    and the model loop come next: docs/stepped-workpiece.md)"
 
 echo
 echo "Outputs: $OUT/plan (G-code, manifest), $OUT/run (controller log, points.csv, inputs.csv, truth.json),"
 echo "         $OUT/eval (errors.csv, evaluation.json, report.md, campaign.gltf), $OUT/machining (cuts.json, cmm_export.csv),"
 echo "         $OUT/campaign (72 h: model.yaml, diagnosis-*.html, fit-*.html with the plots),"
 echo "         $OUT/ttp (thermal test piece: plan/, run/, cmm/ and om/ evaluations, report.html, cmm/test_piece.gltf, r-test/, fit.html),"
-echo "         $OUT/stepped (stepped workpiece W8: plan/ with the roughing, finishing, probing programs; run/ with cmm_export.csv, sw_probe.log)"
+echo "         $OUT/stepped (stepped workpiece W8: plan/ with the roughing, finishing, probing programs; run/ with cmm_export.csv, sw_probe.log; eval/)"
