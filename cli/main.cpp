@@ -40,12 +40,14 @@ std::string join(const std::string& dir, const std::string& file) {
 }
 
 int cmdPlan(const std::string& piece_file, const std::string& machine_file, const std::string& out_dir,
-            const std::string& dialect_opt, const std::string& experiment) {
+            const std::string& dialect_opt, const std::string& experiment, const std::string& compensation_file) {
   const auto piece = parts::loadTestPiece(piece_file);
+  std::optional<parts::SwCompensation> comp;
+  if (!compensation_file.empty()) comp = parts::loadSwCompensation(compensation_file);
   const auto machine = parts::loadMachine(machine_file);
   const bool linux = dialect_opt == "linuxcnc" || (dialect_opt == "machine" && machine.dialect == parts::Dialect::LinuxCnc);
   const auto plan = planner::planTestPiece(piece, machine, linux ? parts::Dialect::LinuxCnc : parts::Dialect::FanucMacroB,
-                                           out_dir, experiment);
+                                           out_dir, experiment, comp ? &*comp : nullptr);
   // Everything is planned and checked before the first file is written.
   for (const auto& p : plan.programs) writeFileAtomic(join(out_dir, p.file), p.text);
   for (const auto& [name, content] : plan.files) writeFileAtomic(join(out_dir, name), content);
@@ -174,6 +176,7 @@ int cmdEvaluate(const std::string& points_file, const std::string& manifest_file
   writeFileAtomic(join(out_dir, evaluate::EvaluationFiles::kErrorsCsv), f.errors_csv);
   writeFileAtomic(join(out_dir, evaluate::EvaluationFiles::kEvaluationJson), f.evaluation_json);
   writeFileAtomic(join(out_dir, evaluate::EvaluationFiles::kReportMd), f.report_md);
+  if (!f.compensation_json.empty()) writeFileAtomic(join(out_dir, "compensation.json"), f.compensation_json);
   std::fputs(f.stdout_text.c_str(), stdout);
   if (!scene.empty()) {
     writeFileAtomic(scene_file, scene);
@@ -268,6 +271,9 @@ int main(int argc, char** argv) {
   plan->add_option("--dialect", dialect, "machine (from the machine file), linuxcnc or fanuc")
       ->check(CLI::IsMember({"machine", "linuxcnc", "fanuc"}))->capture_default_str();
   plan->add_option("--experiment", experiment, "stepped workpiece: the experiment to plan (W1 ... W8, Table 4.1)");
+  std::string compensate;
+  plan->add_option("--compensate", compensate, "stepped workpiece: compensation.json (from evaluate): the predicted wall and "
+                   "floor errors taken out of the finishing path (seed 000 Ch. 6)")->check(CLI::ExistingFile);
 
   auto* res = app.add_subcommand("resolution", "Resolution of the location errors (seed 004 Table 5.4)");
   res->add_option("artifact", artifact, "sphere artifact description (YAML)")->required()->check(CLI::ExistingFile);
@@ -315,7 +321,7 @@ int main(int argc, char** argv) {
   std::string probe_log;
   ev->add_option("--probe-log", probe_log, "stepped workpiece: the on-machine probe log, evaluated with the CMM export (seed 000: CMM - probe)")
       ->check(CLI::ExistingFile);
-  ev->add_option("--compare", compare_with, "thermal test piece: another run's evaluation.json (seed 004 Table 7.2 reductions)")
+  ev->add_option("--compare", compare_with, "another run's evaluation.json: thermal test piece, seed 004 Table 7.2 reductions; stepped workpiece, the part before its compensation (before/after)")
       ->check(CLI::ExistingFile);
 
   FitArgs fa;
@@ -361,7 +367,7 @@ int main(int argc, char** argv) {
   try {
     if (*model_group) return run_model();
     if (*report_group) return run_report();
-    if (*plan) return cmdPlan(artifact, machine, out, dialect, experiment);
+    if (*plan) return cmdPlan(artifact, machine, out, dialect, experiment, compensate);
     if (*res) return cmdResolution(artifact, machine, step_um);
     if (*syn) return cmdSynth(manifest, truth, out, seed);
     if (*simc) return cmdSimulate(sim_programs, machine, part, truth, out, seed, cmm_points, sim_trace, schedule);

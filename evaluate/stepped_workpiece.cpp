@@ -5,10 +5,12 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "core/atomic_file.hpp"
 #include "core/csv.hpp"
 #include "core/error.hpp"
 #include "evaluate/budget_json.hpp"
 #include "geometry/fit.hpp"
+#include "parts/sw_compensation.hpp"
 
 namespace probeloop::evaluate {
 
@@ -251,6 +253,17 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoi
       s.spindle_rpm = m.sw.steps[i].spindle_speed_rpm;
       s.temp_state_min = m.sw.steps[i].temp_state_min;
     }
+    // A compensated plan cut each wall `wall_um` inside and each floor `floor_um` higher on
+    // purpose: the process and spindle errors are against what was commanded, and the
+    // prediction (the physical error of the nominal path) adds the offsets back, so that
+    // compensation.json always holds the whole offset from nominal.
+    double applied[3] = {0, 0, 0};  // width x, width y, depth (um)
+    if (i < m.sw.compensation.size()) {
+      const auto& c = m.sw.compensation[i];
+      applied[0] = c.wall_um[0] + c.wall_um[1];
+      applied[1] = c.wall_um[2] + c.wall_um[3];
+      applied[2] = c.floor_um;
+    }
     s.travel_probe_mm = p.size_mm - d_probe;
     s.travel_tool_mm = p.size_mm + d_tool;
     s.e_pos_x_um = pos[i][0];
@@ -268,17 +281,35 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoi
           contribution("part temperature on the machine", 'B', "rectangular",
                        "20 C +- " + formatNumber(kMachinePartHalfWidthK) + " K (not measured)", alpha * p.size_mm * kMachinePartHalfWidthK / kSqrt3)};
       (a == 0 ? s.e_proc_x_um : s.e_proc_y_um) =
-          uncertainty::combine(std::string("e_proc_") + "xy"[a] + "_um", "um", we - kk.value * lever, cs);
+          uncertainty::combine(std::string("e_proc_") + "xy"[a] + "_um", "um", we + applied[a] - kk.value * lever, cs);
     }
     const int nt = count(e.probe, "TOP"), nf = count(e.probe, stepId(k, "F"));
     s.e_splz_um = uncertainty::combine(
-        "e_splz_um", "um", -p.depth_error_um(),
+        "e_splz_um", "um", -(p.depth_error_um() + applied[2]),
         {contribution("probe repeatability", type_a ? 'A' : 'B', "normal", rep_basis, s_pt * std::sqrt(1.0 / nt + 1.0 / nf), dof_pt),
          contribution("e_pos_z over the depth", 'A', "normal", "u(k_z) x depth", e.k_pos_z_um_per_mm.u_c * p.depth_nominal_mm,
                       e.k_pos_z_um_per_mm.contributions.front().dof),
          contribution("part temperature on the machine", 'B', "rectangular",
                       "20 C +- " + formatNumber(kMachinePartHalfWidthK) + " K (not measured)",
                       alpha * p.depth_nominal_mm * kMachinePartHalfWidthK / kSqrt3)});
+    // Prediction: the same quantities by routes whose contributions are independent.
+    for (int a = 0; a < 3; ++a) {
+      const double L = a < 2 ? p.size_mm - d_probe : p.depth_nominal_mm;
+      const double probe_err = a == 0 ? p.width_x_error_um() : a == 1 ? p.width_y_error_um() : p.depth_error_um();
+      const Budget& kk = *kb[a];
+      const int n1 = count(e.probe, a == 0 ? stepId(k, "XP") : a == 1 ? stepId(k, "YP") : std::string("TOP"));
+      const int n2 = count(e.probe, a == 0 ? stepId(k, "XN") : a == 1 ? stepId(k, "YN") : stepId(k, "F"));
+      const double size = a < 2 ? p.size_mm : p.depth_nominal_mm;
+      std::vector<Contribution> cs{
+          contribution("probe repeatability", type_a ? 'A' : 'B', "normal", rep_basis, s_pt * std::sqrt(1.0 / n1 + 1.0 / n2), dof_pt),
+          contribution("e_pos slope k", 'A', "normal", "u(k) x " + formatNumber(L) + " mm", kk.u_c * L,
+                       kk.contributions.empty() ? 1 : kk.contributions.front().dof),
+          contribution("part temperature on the machine", 'B', "rectangular",
+                       "20 C +- " + formatNumber(kMachinePartHalfWidthK) + " K (not measured)", alpha * size * kMachinePartHalfWidthK / kSqrt3)};
+      const char* q[3] = {"predicted_width_x_um", "predicted_width_y_um", "predicted_depth_um"};
+      Budget& out = a == 0 ? s.predicted_width_x_um : a == 1 ? s.predicted_width_y_um : s.predicted_depth_um;
+      out = uncertainty::combine(q[a], "um", probe_err + applied[a] + kk.value * L, cs);
+    }
     e.steps.push_back(s);
   }
   e.notes.push_back("e_proc: the thermal position error of X and Y (Eq. 3.5/3.6) needs a campaign at constant feed "
@@ -287,6 +318,48 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoi
                     "tip rose between the top's cut and the floor's); e_pos_z is removed by the probe route itself");
   e.notes.push_back("the part's temperature is not corrected on either route; its range is in every budget");
   return e;
+}
+
+void compareWithBefore(SwEvaluation& e, const parts::PlanManifest& m, const std::string& file) {
+  if (m.sw.compensation.empty())
+    throw InputError(m.file, 0, "--compare: this plan was not compensated (plan --compensate); nothing was promised to compare with");
+  nlohmann::json b;
+  try {
+    b = nlohmann::json::parse(readFile(file));
+  } catch (const nlohmann::json::exception& x) {
+    throw InputError(file, 0, std::string("not JSON: ") + x.what());
+  }
+  if (b.value("kind", "") != "stepped_workpiece" || !b.contains("cmm") || !b.at("cmm").contains("steps"))
+    throw InputError(file, 0, "kind: expected the evaluation.json of a stepped workpiece (its CMM route)");
+  if (b.value("experiment", "") != e.experiment)
+    throw InputError(file, 0, "experiment: '" + b.value("experiment", "") + "', this part is " + e.experiment);
+  const auto& bs = b.at("cmm").at("steps");
+  if (bs.size() != e.cmm.steps.size() || m.sw.compensation.size() != e.cmm.steps.size())
+    throw InputError(file, 0, "cmm.steps: " + std::to_string(bs.size()) + " steps, this part has " + std::to_string(e.cmm.steps.size()));
+  e.compared_with = file;
+  for (std::size_t i = 0; i < bs.size(); ++i) {
+    const auto& after = e.cmm.steps[i];
+    const auto& c = m.sw.compensation[i];
+    const struct {
+      const char* q;
+      double after, promised, U;
+    } rows[3] = {{"width_x", after.width_x_error_um(), c.wall_um[0] + c.wall_um[1], c.U_wall_um[0] + c.U_wall_um[1]},
+                 {"width_y", after.width_y_error_um(), c.wall_um[2] + c.wall_um[3], c.U_wall_um[2] + c.U_wall_um[3]},
+                 {"depth", after.depth_error_um(), c.floor_um, c.U_floor_um}};
+    for (const auto& r : rows) {
+      const std::string key = std::string(r.q) + "_error_um";
+      if (!bs[i].contains(key) || !bs[i].at(key).is_number()) throw InputError(file, 0, "cmm.steps[" + std::to_string(i) + "]." + key + ": missing");
+      SwBeforeAfter x;
+      x.step = after.step;
+      x.quantity = r.q;
+      x.before_um = bs[i].at(key).get<double>();
+      x.after_um = r.after;
+      x.fall_um = x.before_um - x.after_um;
+      x.promised_um = r.promised;
+      x.U_promised_um = r.U;
+      e.before_after.push_back(x);
+    }
+  }
 }
 
 namespace {
@@ -343,7 +416,16 @@ std::string swEvaluationJson(const SwEvaluation& e) {
                                {"travel_tool_mm", s.travel_tool_mm}, {"e_pos_x_um", budgetJson(s.e_pos_x_um)},
                                {"e_pos_y_um", budgetJson(s.e_pos_y_um)}, {"e_pos_z_um", budgetJson(s.e_pos_z_um)},
                                {"e_proc_x_um", budgetJson(s.e_proc_x_um)}, {"e_proc_y_um", budgetJson(s.e_proc_y_um)},
-                               {"e_splz_um", budgetJson(s.e_splz_um)}});
+                               {"e_splz_um", budgetJson(s.e_splz_um)},
+                               {"predicted_width_x_um", budgetJson(s.predicted_width_x_um)},
+                               {"predicted_width_y_um", budgetJson(s.predicted_width_y_um)},
+                               {"predicted_depth_um", budgetJson(s.predicted_depth_um)}});
+  if (!e.compared_with.empty()) {
+    j["compared_with"] = e.compared_with;
+    for (const auto& x : e.before_after)
+      j["before_after"].push_back({{"step", x.step}, {"quantity", x.quantity}, {"before_um", x.before_um}, {"after_um", x.after_um},
+                                   {"fall_um", x.fall_um}, {"promised_um", x.promised_um}, {"U_promised_um", x.U_promised_um}});
+  }
   j["notes"] = e.notes;
   return j.dump(1) + "\n";
 }
@@ -370,7 +452,34 @@ std::string swReport(const SwEvaluation& e) {
     << ", k_z = " << bu(e.k_pos_z_um_per_mm) << " um/mm. Probe repeatability (1 sigma, one point): "
     << num(e.probe_repeatability_um, 3) << " um from " << e.probe_repeat_pairs << " repeated points.\n\n";
   for (const auto& n : e.notes) o << "- " << n << "\n";
+  if (!e.compared_with.empty()) {
+    o << "\n## Before and after the compensation (CMM, um)\n\nBefore: " << e.compared_with
+      << ". The promised fall is the compensation the plan applied (U of the prediction, k = 2).\n\n"
+         "| step | feature | before | after | fall | promised |\n|---|---|---|---|---|---|\n";
+    for (const auto& x : e.before_after)
+      o << "| " << x.step << " | " << x.quantity << " | " << num(x.before_um, 2) << " | " << num(x.after_um, 2) << " | "
+        << num(x.fall_um, 2) << " | " << num(x.promised_um, 2) << " ± " << num(x.U_promised_um, 2) << " |\n";
+  }
   return o.str();
+}
+
+std::string swCompensationFile(const SwEvaluation& e) {
+  parts::SwCompensation c;
+  c.experiment = e.experiment;
+  c.basis = "probeloop evaluate: the CMM errors predicted for " + e.experiment +
+            " cut again from the components separated here (docs/stepped-workpiece.md §7); each wall half its width's";
+  for (const auto& s : e.steps) {
+    parts::SwStepCompensation x;
+    x.step = s.step;
+    x.wall_um = {s.predicted_width_x_um.value / 2, s.predicted_width_x_um.value / 2, s.predicted_width_y_um.value / 2,
+                 s.predicted_width_y_um.value / 2};
+    x.U_wall_um = {s.predicted_width_x_um.U / 2, s.predicted_width_x_um.U / 2, s.predicted_width_y_um.U / 2,
+                   s.predicted_width_y_um.U / 2};
+    x.floor_um = s.predicted_depth_um.value;
+    x.U_floor_um = s.predicted_depth_um.U;
+    c.steps.push_back(x);
+  }
+  return parts::swCompensationJson(c);
 }
 
 std::string swStdout(const SwEvaluation& e, const std::string& out_dir) {
@@ -384,7 +493,17 @@ std::string swStdout(const SwEvaluation& e, const std::string& out_dir) {
     o << "  step " << s.step << " (F " << num(s.feed_mm_per_min, 0) << ", T " << num(s.temp_state_min, 1) << " min): e_pos_x "
       << num(s.e_pos_x_um.value, 2) << ", e_proc_x " << num(s.e_proc_x_um.value, 2) << " +- " << num(s.e_proc_x_um.U, 2)
       << ", e_splz " << num(s.e_splz_um.value, 2) << " +- " << num(s.e_splz_um.U, 2) << " um\n";
-  o << "  wrote errors.csv, evaluation.json, report.md in " << out_dir << "\n";
+  if (!e.compared_with.empty()) {
+    double before = 0, after = 0;
+    for (const auto& x : e.before_after) before += x.before_um * x.before_um, after += x.after_um * x.after_um;
+    const double n = static_cast<double>(e.before_after.size());
+    o << "  against " << e.compared_with << " (CMM): rms error of the widths and depths " << num(std::sqrt(before / n), 2)
+      << " um before, " << num(std::sqrt(after / n), 2) << " um after the compensation\n";
+    for (const auto& x : e.before_after)
+      o << "    step " << x.step << " " << x.quantity << ": " << num(x.before_um, 2) << " -> " << num(x.after_um, 2) << " um, fell "
+        << num(x.fall_um, 2) << ", promised " << num(x.promised_um, 2) << " +- " << num(x.U_promised_um, 2) << "\n";
+  }
+  o << "  wrote errors.csv, evaluation.json, report.md, compensation.json in " << out_dir << "\n";
   return o.str();
 }
 

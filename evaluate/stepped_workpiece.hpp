@@ -72,6 +72,20 @@ struct SwStepSeparation {
   uncertainty::Budget e_pos_x_um, e_pos_y_um, e_pos_z_um;
   uncertainty::Budget e_proc_x_um, e_proc_y_um;  // two-wall sums (L1639: half per wall)
   uncertainty::Budget e_splz_um;
+  // Prediction for this experiment cut again (Ch. 6): the CMM width errors, e_pos over the
+  // tool's travel + e_proc (+ e_pt, 0 from one part), i.e. probe width error + k (size - stylus
+  // d); the CMM depth error, probe depth error + k_z depth. Independent contributions only.
+  uncertainty::Budget predicted_width_x_um, predicted_width_y_um, predicted_depth_um;
+};
+
+// A compensated part against the part it was predicted from (`evaluate … --compare
+// before/evaluation.json`): per step and feature the CMM error before and after, the fall, and
+// the fall the compensation promised (the manifest's offsets: the two walls' sum for a width,
+// the floor's for a depth) with its U.
+struct SwBeforeAfter {
+  int step = 0;
+  std::string quantity;  // width_x | width_y | depth
+  double before_um = 0, after_um = 0, fall_um = 0, promised_um = 0, U_promised_um = 0;
 };
 
 struct SwEvaluation {
@@ -82,6 +96,8 @@ struct SwEvaluation {
   uncertainty::Budget k_pos_x_um_per_mm, k_pos_y_um_per_mm, k_pos_z_um_per_mm;
   std::vector<SwStepSeparation> steps;
   std::vector<std::string> notes;
+  std::string compared_with;
+  std::vector<SwBeforeAfter> before_after;
 };
 
 SwSourceGeometry steppedGeometry(const parts::PlanManifest& m, const TtpPoints& points, const std::string& route);
@@ -95,11 +111,19 @@ SwRepeatability probeRepeatability(const parts::PlanManifest& m, const TtpPoints
 
 SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoints& cmm, const TtpPoints& probe);
 
+// Fills before_after from the earlier evaluation.json (InputError naming the file when it is
+// not a stepped-workpiece evaluation of the same experiment and steps) and the manifest's
+// compensation (InputError when the plan was not compensated).
+void compareWithBefore(SwEvaluation& e, const parts::PlanManifest& m, const std::string& before_json_file);
+
 // Outputs: errors.csv (one row per step: the components with u and U), evaluation.json,
 // report.md, and the stdout summary.
 std::string swErrorsCsv(const SwEvaluation& e);
 std::string swEvaluationJson(const SwEvaluation& e);
 std::string swReport(const SwEvaluation& e);
 std::string swStdout(const SwEvaluation& e, const std::string& out_dir);
+// compensation.json (parts/sw_compensation.hpp): each wall half its step's predicted width
+// error (L1639), each floor its predicted depth error, with U.
+std::string swCompensationFile(const SwEvaluation& e);
 
 }  // namespace probeloop::evaluate

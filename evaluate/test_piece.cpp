@@ -79,8 +79,7 @@ EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateReq
 // Seed 000 separates the errors from the CMM and the on-machine measurement of one part:
 // both files together (the CMM export as the points, the probe log with --probe-log).
 EvaluationFiles steppedWorkpiece(const parts::PlanManifest& m, const EvaluateRequest& r) {
-  if (r.free_radius || !r.compare_with.empty())
-    throw InputError("", 0, "--free-radius and --compare do not apply to the stepped workpiece");
+  if (r.free_radius) throw InputError("", 0, "--free-radius does not apply to the stepped workpiece");
   if (r.probe_log.empty())
     throw InputError(r.input_file, 0, "the stepped workpiece is evaluated from its CMM export and its on-machine probe "
                                       "log together: give the log with --probe-log (seed 000 L761: CMM - probe)");
@@ -93,10 +92,12 @@ EvaluationFiles steppedWorkpiece(const parts::PlanManifest& m, const EvaluateReq
     throw InputError(r.probe_log, 0, "--probe-log: expected the on-machine probe log (PT lines) or points CSV, found a " + log_fmt + " file");
   EvaluationFiles f;
   f.stepped_workpiece = evaluateSteppedWorkpiece(m, readTtpCmmExport(r.input_file, text, m), readTtpOnMachine(r.probe_log, log, log_fmt, m));
+  if (!r.compare_with.empty()) compareWithBefore(*f.stepped_workpiece, m, r.compare_with);
   const auto& e = *f.stepped_workpiece;
   f.errors_csv = swErrorsCsv(e);
   f.evaluation_json = swEvaluationJson(e);
   f.report_md = swReport(e);
+  f.compensation_json = swCompensationFile(e);
   f.stdout_text = swStdout(e, r.out_dir);
   return f;
 }

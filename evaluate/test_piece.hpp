@@ -33,6 +33,7 @@ struct EvaluationFiles {
   static constexpr const char* kEvaluationJson = "evaluation.json";
   static constexpr const char* kReportMd = "report.md";
   std::string errors_csv, evaluation_json, report_md, stdout_text;
+  std::string compensation_json;  // stepped workpiece: compensation.json (empty for the other kinds)
   // Sphere artifact: the campaign, for --scene (per-cycle sphere centres, reference cycle).
   std::optional<CampaignEvaluation> sphere;
   std::optional<TtpEvaluation> thermal_test_piece;

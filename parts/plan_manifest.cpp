@@ -136,6 +136,18 @@ std::string genericManifestJson(const PlanManifest& m) {
                                        {"mpe_length_mm", t.cmm.mpe_length_mm},
                                        {"temperature_half_width_K", t.cmm.temperature_half_width_K}}},
                               {"cmm_plan", t.cmm_plan}};
+    if (!t.compensation.empty()) {
+      ordered_json cs = ordered_json::array();
+      for (const auto& c : t.compensation) {
+        ordered_json w, uw;
+        for (int i = 0; i < 4; ++i) {
+          w[kSwWalls[i]] = c.wall_um[static_cast<std::size_t>(i)];
+          uw[kSwWalls[i]] = c.U_wall_um[static_cast<std::size_t>(i)];
+        }
+        cs.push_back({{"step", c.step}, {"wall_um", w}, {"floor_um", c.floor_um}, {"U_wall_um", uw}, {"U_floor_um", c.U_floor_um}});
+      }
+      j["stepped_workpiece"]["compensation"] = {{"file", t.compensation_file}, {"steps", cs}};
+    }
   }
   j["features"] = ordered_json::array();
   for (const auto& f : m.features) {
@@ -267,6 +279,20 @@ void readGeneric(const ordered_json& j, PlanManifest& m) {
     c.transition_feed_mm_per_min = t.at("transition_feed_mm_per_min");
     c.tool_runout_mm = t.at("tool_runout_mm");
     c.tool_diameter_mm = t.at("tool_diameter_mm");
+    if (t.contains("compensation")) {
+      c.compensation_file = t.at("compensation").at("file");
+      for (const auto& s : t.at("compensation").at("steps")) {
+        SwStepCompensation x;
+        x.step = s.at("step");
+        for (int i = 0; i < 4; ++i) {
+          x.wall_um[static_cast<std::size_t>(i)] = s.at("wall_um").at(kSwWalls[i]);
+          x.U_wall_um[static_cast<std::size_t>(i)] = s.at("U_wall_um").at(kSwWalls[i]);
+        }
+        x.floor_um = s.at("floor_um");
+        x.U_floor_um = s.at("U_floor_um");
+        c.compensation.push_back(x);
+      }
+    }
     c.sizes_mm = t.at("sizes_mm").get<std::vector<double>>();
     for (const auto& s : t.at("steps")) {
       ManifestStep x;

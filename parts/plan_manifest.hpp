@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "parts/feature.hpp"
+#include "parts/sw_compensation.hpp"
 #include "parts/workpiece.hpp"
 
 namespace probeloop::parts {
@@ -93,6 +94,8 @@ struct SteppedWorkpieceConstants {
   std::string experiment, transition;
   double transition_feed_mm_per_min = 0, tool_runout_mm = 0;
   double tool_diameter_mm = 0;  // the finishing tool (its centre travels size + d between opposite walls)
+  std::vector<SwStepCompensation> compensation;  // applied to the finishing path (empty: none)
+  std::string compensation_file;
   std::vector<double> sizes_mm;
   std::vector<ManifestStep> steps;
   CmmSpec cmm;

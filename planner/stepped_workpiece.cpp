@@ -28,6 +28,9 @@ std::string xyz(const Vector3d& v) {
 struct Material {
   const SteppedWorkpiece& w;
   std::vector<double> half;  // the cut sizes / 2
+  // Compensation (mm): a finished step's walls as far out as its outermost compensated wall
+  // (the safe side), its floor where the compensated path cut it.
+  std::vector<double> wall_out, floor_up;
   bool blank = true;         // before roughing: the whole blank
   int tops_finished = 0;     // box tops finished: 1 = the top face, 1 + k = the floor of step k too
   int walls_finished = 0;    // steps whose four walls are finished
@@ -43,13 +46,14 @@ struct Material {
               {w.fixture_diameter_mm / 2, w.fixture_diameter_mm / 2, c_bottom - w.fixture_height_mm, c_bottom}};
     std::vector<Box> out;
     const std::size_t n = half.size();
+    const auto shift = [](const std::vector<double>& v, std::size_t j) { return j < v.size() ? v[j] : 0.0; };
     for (std::size_t j = 0; j < n; ++j) {
-      const double top = j == 0 ? 0.0 : -w.steps[j - 1].floor_depth_mm;
-      const double h = half[j] + (static_cast<int>(j) < walls_finished ? 0.0 : m);
+      const double top = j == 0 ? 0.0 : -w.steps[j - 1].floor_depth_mm + shift(floor_up, j - 1);
+      const double h = half[j] + (static_cast<int>(j) < walls_finished ? shift(wall_out, j) : m);
       const double z_hi = top + (static_cast<int>(j) < tops_finished ? 0.0 : m);
       out.push_back({h, h, -w.steps[j].floor_depth_mm, z_hi});
     }
-    const double base_top = -w.steps.back().floor_depth_mm + (static_cast<int>(n) < tops_finished ? 0.0 : m);
+    const double base_top = -w.steps.back().floor_depth_mm + shift(floor_up, n - 1) + (static_cast<int>(n) < tops_finished ? 0.0 : m);
     out.push_back({bx, by, c_bottom, base_top});
     // The fixture under the blank (a box round its circle: the safe side).
     out.push_back({w.fixture_diameter_mm / 2, w.fixture_diameter_mm / 2, c_bottom - w.fixture_height_mm, c_bottom});
@@ -65,14 +69,27 @@ double rectDistance(const Vector2d& p, double hx, double hy) {
 
 class Builder {
  public:
-  Builder(const SteppedWorkpiece& w, const std::string& experiment, const parts::Machine& m, parts::Dialect d)
-      : w_(w), m_(m), dialect_(d), files_(swFiles(d)), material_{w, {}} {
+  Builder(const SteppedWorkpiece& w, const std::string& experiment, const parts::Machine& m, parts::Dialect d,
+          const parts::SwCompensation* comp)
+      : w_(w), m_(m), dialect_(d), files_(swFiles(d)), material_{w, {}, {}, {}} {
+    comp_ = comp;
     e_ = w.experiment(experiment);
+    if (comp_)
+      for (const auto& s : comp_->steps) {
+        material_.wall_out.push_back(-toProgram(std::min({s.wall_um[0], s.wall_um[1], s.wall_um[2], s.wall_um[3]})));
+        material_.floor_up.push_back(toProgram(s.floor_um));
+      }
     if (!e_) {
       std::string ids;
       for (const auto& x : w.experiments) ids += (ids.empty() ? "" : ", ") + x.id;
       throw InputError(w.file, 0, "experiments: no experiment '" + experiment + "' (the description has " + ids + ")");
     }
+    if (comp_ && comp_->experiment != e_->id)
+      throw InputError(comp_->file, 0, "experiment: '" + comp_->experiment + "', but " + e_->id +
+                                           " is planned (its errors belong to its own feeds and times)");
+    if (comp_ && comp_->steps.size() != e_->steps.size())
+      throw InputError(comp_->file, 0, "steps: " + std::to_string(comp_->steps.size()) + " given, experiment " + e_->id + " has " +
+                                           std::to_string(e_->steps.size()));
     sizes_ = w.sizesFor(*e_);
     for (double s : sizes_) material_.half.push_back(s / 2);
     features_ = parts::nominalFeatures(w, sizes_);
@@ -295,7 +312,7 @@ class Builder {
     for (double s = s_out; s > s_fin + 1e-9; s -= step_) rings.push_back(s);
     rings.push_back(s_fin);  // the innermost leaves the wall's margin to the wall pass
     const std::string gk = "S" + std::to_string(k + 1);
-    const double z = air ? z_clear_ : -w_.steps[k].floor_depth_mm;
+    const double z = air ? z_clear_ : -w_.steps[k].floor_depth_mm + floorShift(k);
     auto ci = [&](const std::string& id, const std::string& feature, const Vector2d& a, const Vector2d& b) {
       return air ? -1 : addCut(id, feature, static_cast<int>(k + 1), a, b, z);
     };
@@ -316,12 +333,22 @@ class Builder {
     struct Wall {
       const char* side;
       Vector2d n, dir;
+      int comp;  // index in parts::kSwWalls
     };
-    const Wall walls[4] = {{"YP", {0, 1}, {1, 0}}, {"XP", {1, 0}, {0, -1}}, {"YN", {0, -1}, {-1, 0}}, {"XN", {-1, 0}, {0, 1}}};
+    const Wall walls[4] = {{"YP", {0, 1}, {1, 0}, 2}, {"XP", {1, 0}, {0, -1}, 0}, {"YN", {0, -1}, {-1, 0}, 3}, {"XN", {-1, 0}, {0, 1}, 1}};
+    // The tool centre's distance from the centre line for each wall (compensated).
+    const auto s_of = [&](const Wall& wl) { return air ? s_in : s_in - wallShift(k, wl.comp); };
+    // Where wall i's path line meets wall j's (adjacent): x from the X wall, y from the Y wall.
+    const auto corner = [&](const Wall& a, const Wall& b) {
+      const Wall& xw = a.n.x() != 0 ? a : b;
+      const Wall& yw = a.n.x() != 0 ? b : a;
+      return Vector2d(xw.n.x() * s_of(xw), yw.n.y() * s_of(yw));
+    };
     if (e_->transition == "continuous") {
-      feedXY(Vector2d(-s_in, s_in), F, w + ": in to the wall contour", !air);
-      for (const auto& wl : walls) {
-        const Vector2d a = s_in * (wl.n - wl.dir), b = s_in * (wl.n + wl.dir);
+      feedXY(corner(walls[3], walls[0]), F, w + ": in to the wall contour", !air);
+      for (int i = 0; i < 4; ++i) {
+        const auto& wl = walls[i];
+        const Vector2d a = corner(walls[(i + 3) % 4], wl), b = corner(wl, walls[(i + 1) % 4]);
         const int c = ci(gk + "_" + wl.side, gk + "_" + wl.side, a, b);
         feedXY(b, F, w + ": wall " + gk + "_" + wl.side + " (continuous path)", !air, c);
       }
@@ -330,7 +357,7 @@ class Builder {
       const double Ft = e_->transition_feed_mm_per_min;
       for (int i = 0; i < 4; ++i) {
         const auto& wl = walls[i];
-        const Vector2d a = s_in * wl.n - e * wl.dir, b = s_in * wl.n + e * wl.dir;
+        const Vector2d a = s_of(wl) * wl.n - e * wl.dir, b = s_of(wl) * wl.n + e * wl.dir;
         feedXY(a, Ft, w + ": " + e_->transition + " transition to wall " + gk + "_" + wl.side + " (" + formatNumber(Ft) + " mm/min)");
         const int c = ci(gk + "_" + wl.side, gk + "_" + wl.side, a, b);
         feedXY(b, F, w + ": wall " + gk + "_" + wl.side, !air, c);
@@ -626,6 +653,10 @@ class Builder {
     s.transition_feed_mm_per_min = e_->transition_feed_mm_per_min;
     s.tool_runout_mm = e_->tool_runout_mm;
     s.tool_diameter_mm = tool_->diameter_mm;
+    if (comp_) {
+      s.compensation = comp_->steps;
+      s.compensation_file = comp_->file;
+    }
     s.sizes_mm = sizes_;
     for (const auto& st : plan_.steps) {
       parts::ManifestStep x;
@@ -661,6 +692,14 @@ class Builder {
   SwFiles files_;
   const parts::SwExperiment* e_ = nullptr;
   std::vector<double> sizes_;
+  const parts::SwCompensation* comp_ = nullptr;
+  // Compensation (Ch. 6): wall i of step k (XP, XN, YP, YN) moved inward by its predicted
+  // outward error; the step's floor raised by its predicted depth error. mm.
+  // Rounded to the programs' 0.1 um (4 decimals in mm), so that the material model and the
+  // written coordinates agree.
+  static double toProgram(double um) { return std::round(um * 10.0) * 1e-4; }
+  double wallShift(std::size_t k, int i) const { return comp_ ? toProgram(comp_->steps[k].wall_um[static_cast<std::size_t>(i)]) : 0.0; }
+  double floorShift(std::size_t k) const { return comp_ ? toProgram(comp_->steps[k].floor_um) : 0.0; }
   std::vector<parts::NominalFeature> features_;
   Vector3d O_;
   const parts::CuttingTool* tool_ = nullptr;
@@ -687,8 +726,8 @@ SwFiles swFiles(parts::Dialect d) {
 }
 
 SteppedWorkpiecePlan planSteppedWorkpiece(const SteppedWorkpiece& w, const std::string& experiment, const parts::Machine& m,
-                                          parts::Dialect dialect) {
-  return Builder(w, experiment, m, dialect).build();
+                                          parts::Dialect dialect, const parts::SwCompensation* compensation) {
+  return Builder(w, experiment, m, dialect, compensation).build();
 }
 
 std::string swProgramText(const NotedProgram& p, parts::Dialect dialect) {

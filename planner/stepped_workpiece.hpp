@@ -36,6 +36,7 @@
 #include "parts/machine.hpp"
 #include "parts/plan_manifest.hpp"
 #include "parts/stepped_workpiece.hpp"
+#include "parts/sw_compensation.hpp"
 #include "planner/program_walker.hpp"
 
 namespace probeloop::planner {
@@ -65,8 +66,12 @@ struct SwFiles {
 };
 SwFiles swFiles(parts::Dialect dialect);  // roughing.ngc, finishing.ngc, probing.ngc (LinuxCNC); .nc for Fanuc
 
+// compensation (optional, `plan --compensate`): the predicted errors of this experiment's walls
+// and floors (parts/sw_compensation.hpp), taken out of the finishing path; refused when it is
+// for another experiment or another number of steps. The manifest records it.
 SteppedWorkpiecePlan planSteppedWorkpiece(const parts::SteppedWorkpiece& w, const std::string& experiment,
-                                          const parts::Machine& m, parts::Dialect dialect);
+                                          const parts::Machine& m, parts::Dialect dialect,
+                                          const parts::SwCompensation* compensation = nullptr);
 
 // Program text of one planned program in the dialect (Fanuc numbers O3001..O3003).
 std::string swProgramText(const NotedProgram& p, parts::Dialect dialect);

@@ -174,13 +174,13 @@ std::string hm(double s) {
 }
 
 TestPiecePlan stepped(const parts::SteppedWorkpiece& w, const std::string& experiment, const parts::Machine& m,
-                      parts::Dialect dialect, const std::string& out_dir) {
+                      parts::Dialect dialect, const std::string& out_dir, const parts::SwCompensation* comp) {
   if (experiment.empty()) {
     std::string ids;
     for (const auto& e : w.experiments) ids += (ids.empty() ? "" : ", ") + e.id;
     throw InputError(w.file, 0, "kind: stepped_workpiece: choose the experiment to plan with --experiment (one of " + ids + ")");
   }
-  auto plan = planSteppedWorkpiece(w, experiment, m, dialect);
+  auto plan = planSteppedWorkpiece(w, experiment, m, dialect, comp);
   TestPiecePlan out;
   out.programs = plannedPrograms(plan.programs, plan.start_s, plan.duration_s, dialect);
   const auto& man = plan.manifest;
@@ -205,6 +205,12 @@ TestPiecePlan stepped(const parts::SteppedWorkpiece& w, const std::string& exper
     s << "\n";
     s << timesLine(plan.times[i]);
   }
+  if (comp) {
+    s << "Compensated (" << comp->file << "): walls moved in by XP/XN/YP/YN, floors raised by, um:\n";
+    for (const auto& c : comp->steps)
+      s << "  step " << c.step << ": " << formatNumber(c.wall_um[0], 2) << " / " << formatNumber(c.wall_um[1], 2) << " / "
+        << formatNumber(c.wall_um[2], 2) << " / " << formatNumber(c.wall_um[3], 2) << ", floor " << formatNumber(c.floor_um, 2) << "\n";
+  }
   s << "Steps (Temp state T = mid-time of the step's wall cuts from the start of step 1, min):\n";
   for (const auto& st : plan.steps)
     s << "  step " << st.step << ": feed XY " << formatNumber(st.conditions.feed_xy_mm_per_min) << " / Z "
@@ -222,8 +228,12 @@ TestPiecePlan stepped(const parts::SteppedWorkpiece& w, const std::string& exper
 }  // namespace
 
 TestPiecePlan planTestPiece(const parts::TestPiece& piece, const parts::Machine& machine, parts::Dialect dialect,
-                            const std::string& out_dir, const std::string& experiment) {
-  if (const auto* w = piece.steppedWorkpiece()) return stepped(*w, experiment, machine, dialect, out_dir);
+                            const std::string& out_dir, const std::string& experiment,
+                            const parts::SwCompensation* compensation) {
+  if (const auto* w = piece.steppedWorkpiece()) return stepped(*w, experiment, machine, dialect, out_dir, compensation);
+  if (compensation)
+    throw InputError(compensation->file, 0, "--compensate: only a stepped workpiece's finishing takes a compensation (this is kind: " +
+                                                piece.kind + ")");
   if (!experiment.empty())
     throw InputError(piece.file, 0, "--experiment " + experiment + ": only a stepped workpiece has experiments (this is kind: " +
                                         piece.kind + ")");

@@ -35,6 +35,7 @@ struct TestPiecePlan {
 };
 
 TestPiecePlan planTestPiece(const parts::TestPiece& piece, const parts::Machine& machine, parts::Dialect dialect,
-                            const std::string& out_dir = "", const std::string& experiment = "");
+                            const std::string& out_dir = "", const std::string& experiment = "",
+                            const parts::SwCompensation* compensation = nullptr);
 
 }  // namespace probeloop::planner

@@ -17,6 +17,11 @@ and the truth file alone (not from the evaluation's code):
 Each must agree within its U (k = 2); and the large ones must be resolved (|truth| > U), so
 the test could fail. A second seed repeats the recovery.
 
+Then the compensation (Ch. 6): seed 1's compensation.json -> plan --compensate -> simulate
+(seed 2) -> evaluate --compare: each width and depth of the surfaces as cut (truth.json) falls
+by what the compensation promised within its U; the CMM's rms error falls by 80 % or more;
+and the compensated part's components again agree with the truth (the offsets accounted).
+
 Needs $PROBELOOP and $PROBELOOP_SOURCE_DIR.
 """
 import csv, json, os, re, subprocess, sys, tempfile
@@ -55,28 +60,30 @@ k_truth = {"x": coefficient(truth_text, "X", "EXX_um"), "y": coefficient(truth_t
            "z": coefficient(truth_text, "Z", "EZZ_um")}
 check("the truth file has position errors to find", k_truth["x"] > 0.05 and k_truth["y"] > 0.05, k_truth)
 
-for seed in ("1", "7"):
-    run_dir, ev_dir = f"{W}/run{seed}", f"{W}/ev{seed}"
+def simulate_and_evaluate(label, plan_dir, seed, compare=None):
+    run_dir, ev_dir = f"{W}/run-{label}", f"{W}/ev-{label}"
     code, out, err = run("simulate", "roughing.ngc", "finishing.ngc", "probing.ngc", "--machine", VMC, "--part", PIECE,
                          "--truth", TRUTH, "--cmm-points", "cmm_points.csv", "--schedule", "plan.json", "--out", run_dir,
                          "--seed", seed, cwd=plan_dir)
-    check(f"seed {seed}: simulate W8 with the plan's schedule", code == 0, err)
+    check(f"{label}: simulate W8 with the plan's schedule", code == 0, err)
     hours = re.search(r"([\d.]+) h of machine time", out)
     # roughing + 3 h off + finishing + 3 h off + probing (plan.json's clock)
     planned_h = (manifest["programs"][-1]["start_s"] + manifest["programs"][-1]["duration_s"]) / 3600
-    check(f"seed {seed}: the machine-off waits are simulated ({hours.group(1) if hours else '?'} h, planned {planned_h:.2f} h)",
+    check(f"{label}: the machine-off waits are simulated ({hours.group(1) if hours else '?'} h, planned {planned_h:.2f} h)",
           hours and abs(float(hours.group(1)) - planned_h) < 0.15, out)
-    code, out, err = run("evaluate", f"{run_dir}/cmm_export.csv", "--probe-log", f"{run_dir}/sw_probe.log", "--manifest",
-                         f"{plan_dir}/plan.json", "--out", ev_dir)
-    check(f"seed {seed}: evaluate CMM export + probe log", code == 0, err)
-    if code != 0:
-        continue
+    args = ["evaluate", f"{run_dir}/cmm_export.csv", "--probe-log", f"{run_dir}/sw_probe.log", "--manifest",
+            f"{plan_dir}/plan.json", "--out", ev_dir]
+    code, out, err = run(*args, *(["--compare", compare] if compare else []))
+    check(f"{label}: evaluate CMM export + probe log", code == 0, err)
+    return run_dir, ev_dir, out
+
+
+def truth_recovery(label, run_dir, ev_dir):
+    """Every separated component of the evaluation against the simulator's truth."""
     ev = json.load(open(f"{ev_dir}/evaluation.json"))
     truth = json.load(open(f"{run_dir}/truth.json"))
     feats = {f["id"]: f for f in truth["features"]}
-
-    # truth per probed feature: mean axis error at its contacts
-    axes = {}
+    axes = {}  # truth per probed feature: the axes' error at each contact
     for e in truth["events"]:
         axes.setdefault(feature_of[e["position"]], []).append(e["axes_um"])
 
@@ -91,9 +98,9 @@ for seed in ("1", "7"):
     def near(name, b, t, resolved=False):
         ok = abs(b["value"] - t) <= b["U"]
         detail = f"{b['value']:.3f} vs truth {t:.3f}, U {b['U']:.3f}"
-        check(f"seed {seed}: {name} {detail}", ok and (not resolved or abs(t) > b["U"]), detail)
+        check(f"{label}: {name} {detail}", ok and (not resolved or abs(t) > b["U"]), detail)
 
-    for a, axis in ((0, "x"), (1, "y")):
+    for axis in ("x", "y"):
         near(f"k_pos_{axis}", ev[f"k_pos_{axis}_um_per_mm"], k_truth[axis], resolved=True)
     near("k_pos_z", ev["k_pos_z_um_per_mm"], k_truth["z"])
     for s in ev["separation"]:
@@ -107,12 +114,58 @@ for seed in ("1", "7"):
         t = feats[f"S{k}_F"]["machine"]["tool_um"][2] - feats["TOP"]["machine"]["tool_um"][2]
         near(f"step {k} e_splz (T {s['temp_state_min']:.0f} min)", s["e_splz_um"], t, resolved=k >= 2)
     rows = list(csv.DictReader(line for line in open(f"{ev_dir}/errors.csv") if not line.startswith("#")))
-    check(f"seed {seed}: errors.csv has a row per step with U", len(rows) == 4 and all(float(r["U_e_splz_um"]) > 0 for r in rows), rows)
+    check(f"{label}: errors.csv has a row per step with U", len(rows) == 4 and all(float(r["U_e_splz_um"]) > 0 for r in rows), rows)
+    return ev, feats
+
+
+def as_cut_errors(feats, sizes, depths):
+    """Width X, width Y and depth errors (um) of the surfaces as cut (truth.json), per step."""
+    out = []
+    for k in range(1, 5):
+        p = lambda i, c: feats[f"S{k}_{i}"]["as_cut"]["point_mm"][c]
+        out.append({"width_x": (p("XP", 0) - p("XN", 0) - sizes[k - 1]) * 1e3,
+                    "width_y": (p("YP", 1) - p("YN", 1) - sizes[k - 1]) * 1e3,
+                    "depth": (feats["TOP"]["as_cut"]["point_mm"][2] - p("F", 2) - depths[k - 1]) * 1e3})
+    return out
+
+
+results = {}
+for seed in ("1", "7"):
+    run_dir, ev_dir, _ = simulate_and_evaluate(f"seed {seed}", plan_dir, seed)
+    results[seed] = (run_dir, ev_dir) + truth_recovery(f"seed {seed}", run_dir, ev_dir)
+
+# --- compensation (Ch. 6): the prediction of seed 1 taken out of the path, cut again (seed 2) ----
+run1, ev1, before_ev, before_feats = results["1"]
+comp = json.load(open(f"{ev1}/compensation.json"))
+check("compensation.json: 4 steps, each wall half its width's predicted error with U",
+      len(comp["steps"]) == 4 and all(abs(s["wall_um"]["XP"] - s["wall_um"]["XN"]) < 1e-12 and s["U_wall_um"]["XP"] > 0
+                                      for s in comp["steps"]), comp)
+plan_c = f"{W}/plan-compensated"
+code, out, err = run("plan", PIECE, "--machine", VMC, "--out", plan_c, "--experiment", "W8", "--compensate", f"{ev1}/compensation.json")
+check("plan W8 --compensate", code == 0 and "Compensated" in out, err)
+cman = json.load(open(f"{plan_c}/plan.json"))
+check("the manifest records the compensation", len(cman["stepped_workpiece"]["compensation"]["steps"]) == 4, cman["stepped_workpiece"])
+run_c, ev_c, out = simulate_and_evaluate("compensated", plan_c, "2", compare=f"{ev1}/evaluation.json")
+after_ev, after_feats = truth_recovery("compensated", run_c, ev_c)
+sizes = manifest["stepped_workpiece"]["sizes_mm"]
+depths = [-f["point_mm"][2] for f in manifest["features"] if f["role"] == "floor"]
+tb, ta = as_cut_errors(before_feats, sizes, depths), as_cut_errors(after_feats, sizes, depths)
+ba = {(x["step"], x["quantity"]): x for x in after_ev["before_after"]}
+check("before/after: 3 rows per step", len(ba) == 12, after_ev.get("before_after"))
+for k in range(1, 5):
+    for q in ("width_x", "width_y", "depth"):
+        x = ba[(k, q)]
+        fall = tb[k - 1][q] - ta[k - 1][q]
+        check(f"step {k} {q}: the surfaces as cut fell {fall:.2f} um, promised {x['promised_um']:.2f} +- {x['U_promised_um']:.2f}",
+              abs(fall - x["promised_um"]) <= x["U_promised_um"], x)
+rms = lambda key: (sum(x[key] ** 2 for x in ba.values()) / len(ba)) ** 0.5
+check(f"the CMM's rms error of widths and depths falls from {rms('before_um'):.2f} to {rms('after_um'):.2f} um (by 80 % or more)",
+      rms("after_um") < 0.2 * rms("before_um"), out)
 
 # --- bad input ---------------------------------------------------------------------------------
-code, out, err = run("evaluate", f"{W}/run1/cmm_export.csv", "--manifest", f"{plan_dir}/plan.json", "--out", f"{W}/bad")
+code, out, err = run("evaluate", f"{run1}/cmm_export.csv", "--manifest", f"{plan_dir}/plan.json", "--out", f"{W}/bad")
 check("the CMM export alone is refused: the probe log is needed", code != 0 and "--probe-log" in err and not os.path.exists(f"{W}/bad"), err)
-code, out, err = run("evaluate", f"{W}/run1/cmm_export.csv", "--probe-log", f"{W}/run1/cmm_export.csv", "--manifest",
+code, out, err = run("evaluate", f"{run1}/cmm_export.csv", "--probe-log", f"{run1}/cmm_export.csv", "--manifest",
                      f"{plan_dir}/plan.json", "--out", f"{W}/bad")
 check("a CMM export given as the probe log is refused", code != 0 and "expected the on-machine probe log" in err, err)
 code, out, err = run("simulate", "probing.ngc", "--machine", VMC, "--part", PIECE, "--truth", TRUTH, "--schedule",
