@@ -31,6 +31,9 @@ Checks:
     Z constant (1e-4 mm) = the planned Z; the four walls S<k>_XP/XN/YP/YN of every step are
     cut at that step's floor depth (the Z of its floor cuts S<k>_F-*, and with --part the top's
     Z minus the step's floor_depth), at the step's feed_xy with the spindle at its speed;
+    every wall cut runs at the tool's radius from its nominal face; with --compensation (the
+    file given to plan --compensate) the walls move in by wall_um and the floors up by
+    floor_um (each rounded to the programs' 0.1 um);
   probing: every STRAIGHT_PROBE is either a measuring move (a LOG follows) whose target is
     the planned overtravel end on the approach line (contact + overtravel * approach), or a
     protected move ending at the next point's start (contact - approach_mm * approach); every
@@ -73,6 +76,7 @@ ap.add_argument("--approach", type=float, required=True, metavar="MM", help="pro
 ap.add_argument("--overtravel", type=float, required=True, metavar="MM", help="probing.overtravel of the description")
 ap.add_argument("--machine", required=True, metavar="YAML", help="the machine description the plan was made for")
 ap.add_argument("--part", metavar="YAML", help="the stepped-workpiece description (procedure waits, floor depths)")
+ap.add_argument("--compensation", metavar="JSON", help="the compensation.json the plan was made with (plan --compensate)")
 ap.add_argument("--tol-s", type=float, default=1e-3, metavar="S", help="time tolerance, s (default 0.001)")
 args = ap.parse_args()
 for name in ("approach", "overtravel"):
@@ -258,6 +262,17 @@ if args.part:
     FLOOR = [quantity(s["floor_depth"], "length", "steps[].floor_depth") for s in get(desc, "steps", args.part)]
 
 plan = json.load(open(args.plan))
+COMP = json.load(open(args.compensation)) if args.compensation else None
+
+
+def comp_mm(step, key):
+    """The compensation of step `step` (wall side XP/XN/YP/YN or floor_um), mm, rounded as the
+    programs are written (0.1 um)."""
+    if COMP is None:
+        return 0.0
+    s = COMP["steps"][step - 1]
+    um = s["floor_um"] if key == "floor_um" else s["wall_um"][key]
+    return round(um * 10) / 1e4
 roles = [p.get("role") for p in plan["programs"]]
 if roles != ["roughing", "finishing", "probing"]:
     sys.exit(f"check_sw_rs274.py: the manifest's programs are {roles}, expected roughing, finishing, probing")
@@ -560,10 +575,22 @@ for k, st in enumerate(steps if len(fin_dw) == max(len(steps) - 1, 0) else []): 
         if len(floor_z) != 1 or abs(z - next(iter(floor_z))) > TOL:
             errors.append(f"finishing: wall {c['feature']} cut at Z {z}, the floor of step {n} at Z {sorted(floor_z)}")
         if desc is not None and tops and n <= len(FLOOR):
-            want = tops[0]["to_mm"][2] - FLOOR[n - 1]
+            want = tops[0]["to_mm"][2] - FLOOR[n - 1] + comp_mm(n, "floor_um")
             if abs(z - want) > TOL:
                 errors.append(f"finishing: wall {c['feature']} cut at Z {z}, the top at {tops[0]['to_mm'][2]} minus the "
                               f"description's floor_depth {FLOOR[n - 1]} of step {n} is {want}")
+        # The tool's axis at its radius from the nominal face (moved in by the compensation).
+        face = next((f for f in plan["features"] if f["id"] == c["feature"]), None)
+        if face is not None:
+            nrm, pt = face["direction"], [face["point_mm"][i] + plan["part"]["origin_mm"][i] for i in range(3)]
+            want_d = sw["tool_diameter_mm"] / 2 - comp_mm(n, side)
+            for m in run:
+                for q in (m.start, m.end):
+                    d = sum(nrm[i] * (q[i] - pt[i]) for i in range(2))
+                    if abs(d - want_d) > TOL:
+                        errors.append(f"finishing: wall {c['feature']} cut {d:.5f} mm from its nominal face, expected "
+                                      f"{want_d:.5f} (tool radius - compensation)")
+                        break
         if any(abs(m.F - st["feed_xy_mm_per_min"]) > 1e-3 for m in run):
             errors.append(f"finishing: wall {c['feature']} cut at F {run[0].F}, step {n}'s feed_xy is {st['feed_xy_mm_per_min']}")
         if any(abs(m.spindle[1] - st["spindle_speed_rpm"]) > 0.5 for m in run):

@@ -51,6 +51,18 @@ for name, exp, dialect in (("w8_lc", "W8", "linuxcnc"), ("w8_fa", "W8", "fanuc")
     if name == "w8_lc":
         print("\n".join("     " + l for l in out.splitlines()[:14]))
     dirs[name] = d
+# W5 (one continuous contour) compensated with unequal offsets per wall and floor: the corners
+# of the shifted contour and the raised/lowered floors go through rs274 below like the rest.
+COMP = {"format": "probeloop-compensation", "kind": "stepped_workpiece", "experiment": "W5",
+        "steps": [{"step": k, "wall_um": {"XP": 3.0 * k, "XN": -1.5 * k, "YP": 5.0 * k, "YN": 2.5},
+                   "floor_um": -4.0 * k + 2} for k in range(1, 5)]}
+open(f"{W}/w5_comp.json", "w").write(json.dumps(COMP))
+code, out, err = run("plan", PIECE, "--machine", VMC, "--out", f"{W}/w5c_lc", "--experiment", "W5", "--compensate", f"{W}/w5_comp.json")
+check("plan W5 --compensate (continuous path, unequal offsets)", code == 0, err)
+dirs["w5c_lc"] = f"{W}/w5c_lc"
+code, out, err = run("plan", PIECE, "--machine", VMC, "--out", f"{W}/bad_comp", "--experiment", "W8", "--compensate", f"{W}/w5_comp.json")
+check("a compensation for W5 is refused when W8 is planned", code != 0 and "experiment: 'W5', but W8 is planned" in err
+      and not os.path.exists(f"{W}/bad_comp"), err)
 for name, ext in (("w8_lc", "ngc"), ("w8_fa", "nc")):
     want = sorted([f"roughing.{ext}", f"finishing.{ext}", f"probing.{ext}", "cmm_points.csv", "plan.json"])
     got = sorted(os.listdir(dirs[name])) if os.path.isdir(dirs[name]) else []
@@ -108,7 +120,7 @@ if shutil.which("rs274"):
     probing = TEXT[TEXT.index("\nprobing:"):]
     approach = re.search(r"\n\s+approach: ([\d.]+) mm", probing).group(1)
     overtravel = re.search(r"\n\s+overtravel: ([\d.]+) mm", probing).group(1)
-    for name in ("w8_lc", "w2_lc", "w5_lc"):
+    for name in ("w8_lc", "w2_lc", "w5_lc", "w5c_lc"):
         d = dirs[name]
         if name not in man:
             continue
@@ -118,9 +130,10 @@ if shutil.which("rs274"):
             open(f"{d}/{p['file']}.canon", "w").write(c.stdout + c.stderr)
             canons.append(f"{d}/{p['file']}.canon")
         p = subprocess.run([sys.executable, f"{SRC}/tests/integration/check_sw_rs274.py", f"{d}/plan.json", *canons,
-                            "--approach", approach, "--overtravel", overtravel, "--machine", VMC, "--part", PIECE],
+                            "--approach", approach, "--overtravel", overtravel, "--machine", VMC, "--part", PIECE,
+                            *(["--compensation", f"{W}/w5_comp.json"] if name == "w5c_lc" else [])],
                            capture_output=True, text=True)
-        exp = man[name]["stepped_workpiece"]["experiment"]
+        exp = man[name]["stepped_workpiece"]["experiment"] + (" (compensated)" if name == "w5c_lc" else "")
         check(f"rs274 accepts the three {exp} programs; cuts, probe moves and the manifest's times agree with "
               f"rs274's re-timed canonical calls", p.returncode == 0, p.stdout + p.stderr)
         print("\n".join("     " + l for l in p.stdout.splitlines()[-3:]))
