@@ -128,12 +128,21 @@ $PL simulate "$S/plan/roughing.ngc" "$S/plan/finishing.ngc" "$S/plan/probing.ngc
   --schedule "$S/plan/plan.json" --out "$S/run" | sed 's/^/   /'
 echo "-- CMM - probe, process and spindle errors per step (truth: 0.15 / 0.25 um/mm; the rest in $S/run/truth.json)"
 $PL evaluate "$S/run/cmm_export.csv" --probe-log "$S/run/sw_probe.log" --manifest "$S/plan/plan.json" --out "$S/eval" | sed 's/^/   /'
-echo "   (the thesis's tables are reproduced by evaluate/stepped_separation_test; the campaign, compensation"
-echo "    and the model loop come next: docs/stepped-workpiece.md)"
+echo "-- compensation (Ch. 6): the predicted errors out of the finishing path, W8 cut again, before/after"
+$PL plan parts/stepped_workpiece.yaml --machine parts/machines/vmc3.yaml --out "$S/plan-compensated" --experiment W8 \
+  --compensate "$S/eval/compensation.json" | sed -n '/^Compensated/,/^Steps/p' | sed '$d' | sed 's/^/   /'
+$PL simulate "$S/plan-compensated/roughing.ngc" "$S/plan-compensated/finishing.ngc" "$S/plan-compensated/probing.ngc" \
+  --machine parts/machines/vmc3.yaml --part parts/stepped_workpiece.yaml --truth examples/stepped_workpiece/truth.yaml \
+  --cmm-points "$S/plan-compensated/cmm_points.csv" --schedule "$S/plan-compensated/plan.json" --seed 2 --out "$S/run-compensated" > /dev/null
+$PL evaluate "$S/run-compensated/cmm_export.csv" --probe-log "$S/run-compensated/sw_probe.log" \
+  --manifest "$S/plan-compensated/plan.json" --compare "$S/eval/evaluation.json" --out "$S/eval-compensated" | grep -A13 'against' | sed 's/^/   /'
+echo "   (the thesis's tables are reproduced by evaluate/stepped_separation_test; the campaign and the model"
+echo "    loop come next: docs/stepped-workpiece.md)"
 
 echo
 echo "Outputs: $OUT/plan (G-code, manifest), $OUT/run (controller log, points.csv, inputs.csv, truth.json),"
 echo "         $OUT/eval (errors.csv, evaluation.json, report.md, campaign.gltf), $OUT/machining (cuts.json, cmm_export.csv),"
 echo "         $OUT/campaign (72 h: model.yaml, diagnosis-*.html, fit-*.html with the plots),"
 echo "         $OUT/ttp (thermal test piece: plan/, run/, cmm/ and om/ evaluations, report.html, cmm/test_piece.gltf, r-test/, fit.html),"
-echo "         $OUT/stepped (stepped workpiece W8: plan/ with the roughing, finishing, probing programs; run/ with cmm_export.csv, sw_probe.log; eval/)"
+echo "         $OUT/stepped (stepped workpiece W8: plan/ with the roughing, finishing, probing programs; run/ with cmm_export.csv, sw_probe.log; eval/ with compensation.json;
+         plan-compensated/, run-compensated/, eval-compensated/ with report.md before/after)"
