@@ -8,6 +8,7 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "parts/plan_manifest.hpp"
+#include "report/sw_report.hpp"
 #include "report/ttp_report.hpp"
 #include "report/ttp_scene.hpp"
 
@@ -75,6 +76,18 @@ int runTtp(TtpArgs a) {
   return 0;
 }
 
+struct SwArgs {
+  std::string evaluation, html;
+};
+
+int runStepped(const SwArgs& a) {
+  const nlohmann::json evaluation = readJson(a.evaluation);
+  const std::string html = report::steppedWorkpieceReportHtml(evaluation, a.evaluation);
+  writeFileAtomic(a.html, html);
+  std::printf("Wrote %s (stepped-workpiece report: %s)\n", a.html.c_str(), a.evaluation.c_str());
+  return 0;
+}
+
 }  // namespace
 
 std::function<int()> addReportCommands(CLI::App& app, CLI::App*& group) {
@@ -107,8 +120,17 @@ std::function<int()> addReportCommands(CLI::App& app, CLI::App*& group) {
                   "Eq. 7.10 for the table: the R-test sphere's radius from the C axis, mm")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
-  return [a, ttp]() -> int {
+  auto s = std::make_shared<SwArgs>();
+  auto* sw = group->add_subcommand(
+      "stepped", "Stepped workpiece (seed 000): the separated components with U against travel, feed and Temp state; "
+                 "a compensated part's before/after per feature (HTML)");
+  sw->add_option("--evaluation", s->evaluation, "evaluation.json of `probeloop evaluate … --probe-log` (with --compare: before/after)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  sw->add_option("--html", s->html, "write the HTML report to this file")->required();
+  return [a, ttp, s, sw]() -> int {
     if (*ttp) return runTtp(*a);
+    if (*sw) return runStepped(*s);
     return 2;
   };
 }

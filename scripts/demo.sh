@@ -136,6 +136,7 @@ $PL simulate "$S/plan-compensated/roughing.ngc" "$S/plan-compensated/finishing.n
   --cmm-points "$S/plan-compensated/cmm_points.csv" --schedule "$S/plan-compensated/plan.json" --seed 2 --out "$S/run-compensated" > /dev/null
 $PL evaluate "$S/run-compensated/cmm_export.csv" --probe-log "$S/run-compensated/sw_probe.log" \
   --manifest "$S/plan-compensated/plan.json" --compare "$S/eval/evaluation.json" --out "$S/eval-compensated" | grep -A13 'against' | sed 's/^/   /'
+$PL report stepped --evaluation "$S/eval-compensated/evaluation.json" --html "$S/report.html" | sed 's/^/   /'
 echo "   (the thesis's tables are reproduced by evaluate/stepped_separation_test; the campaign and the model"
 echo "    loop come next: docs/stepped-workpiece.md)"
 
@@ -145,4 +146,4 @@ echo "         $OUT/eval (errors.csv, evaluation.json, report.md, campaign.gltf)
 echo "         $OUT/campaign (72 h: model.yaml, diagnosis-*.html, fit-*.html with the plots),"
 echo "         $OUT/ttp (thermal test piece: plan/, run/, cmm/ and om/ evaluations, report.html, cmm/test_piece.gltf, r-test/, fit.html),"
 echo "         $OUT/stepped (stepped workpiece W8: plan/ with the roughing, finishing, probing programs; run/ with cmm_export.csv, sw_probe.log; eval/ with compensation.json;
-         plan-compensated/, run-compensated/, eval-compensated/ with report.md before/after)"
+         plan-compensated/, run-compensated/, eval-compensated/ with before/after; report.html)"

@@ -159,6 +159,18 @@ for k in range(1, 5):
         check(f"step {k} {q}: the surfaces as cut fell {fall:.2f} um, promised {x['promised_um']:.2f} +- {x['U_promised_um']:.2f}",
               abs(fall - x["promised_um"]) <= x["U_promised_um"], x)
 rms = lambda key: (sum(x[key] ** 2 for x in ba.values()) / len(ba)) ** 0.5
+# --- the HTML report, rendered in Chromium -----------------------------------------------------------
+from html_render import check as render_check  # noqa: E402
+for name, ev_dir, plots in (("one part", ev1, 3), ("compensated part", ev_c, 4)):
+    code, out, err = run("report", "stepped", "--evaluation", f"{ev_dir}/evaluation.json", "--html", f"{ev_dir}/report.html")
+    ok, text = render_check(f"{ev_dir}/report.html", plots) if code == 0 else (False, err)
+    check(f"report stepped ({name}): {plots} plots render in Chromium with no error", ok, text)
+page = open(f"{ev_c}/report.html").read() if os.path.exists(f"{ev_c}/report.html") else ""
+check("the report's before/after table lists the 12 widths and depths",
+      all(f"S{k} {q}" in page for k in range(1, 5) for q in ("width_x", "width_y", "depth")), page[:300])
+code, out, err = run("report", "stepped", "--evaluation", f"{plan_dir}/plan.json", "--html", f"{W}/bad.html")
+check("report stepped refuses what is not a stepped-workpiece evaluation", code != 0 and "plan.json" in err
+      and not os.path.exists(f"{W}/bad.html"), err)
 check(f"the CMM's rms error of widths and depths falls from {rms('before_um'):.2f} to {rms('after_um'):.2f} um (by 80 % or more)",
       rms("after_um") < 0.2 * rms("before_um"), out)
 
