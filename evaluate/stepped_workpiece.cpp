@@ -1,5 +1,6 @@
 #include "evaluate/stepped_workpiece.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -128,11 +129,8 @@ SwSourceGeometry steppedGeometry(const parts::PlanManifest& m, const TtpPoints& 
     s.width_y_mm = onPlane(yp, 1, c, g.file) - onPlane(yn, 1, c, g.file);
     s.u_wall_x_um = std::hypot(xp.rms_um / std::sqrt(xp.points), xn.rms_um / std::sqrt(xn.points));
     s.u_wall_y_um = std::hypot(yp.rms_um / std::sqrt(yp.points), yn.rms_um / std::sqrt(yn.points));
-    Vector3d fc = Vector3d::Zero();
-    int nf = 0;
-    for (const auto& p : pts.points)
-      if (p.feature == fl.id) fc += p.p_mm, ++nf;
-    fc /= nf;
+    // Both routes at the same place: the floor's nominal centre (the step's axis).
+    const Vector3d fc = ffl->nominal.point_mm;
     s.depth_mm = onPlane(top, 2, fc, g.file) - onPlane(fl, 2, fc, g.file);
     s.u_depth_um = std::hypot(top.rms_um / std::sqrt(top.points), fl.rms_um / std::sqrt(fl.points));
     s.lean_x_urad = 0.5 * (slope(xp, 0, 2) + slope(xn, 0, 2)) * 1e6;
@@ -152,20 +150,34 @@ SwRepeatability probeRepeatability(const parts::PlanManifest& m, const TtpPoints
   // (feature, point) -> nominal contact and approach
   std::map<std::pair<std::string, int>, const parts::ManifestPoint*> plan;
   for (const auto& p : m.points) plan[{p.feature, p.point}] = &p;
-  std::map<std::string, std::vector<std::pair<const parts::ManifestPoint*, Vector3d>>> seen;
-  SwRepeatability r;
-  double ss = 0;
+  // Groups of touches of one planned place (same feature, same nominal contact): their
+  // positions along the approach; s pooled over the groups with sum (n_i - 1) degrees of freedom.
+  struct Group {
+    const parts::ManifestPoint* where;
+    std::vector<double> along;
+  };
+  std::map<std::string, std::vector<Group>> groups;
   for (const auto& p : probe.points) {
     const auto it = plan.find({p.feature, p.point});
     if (it == plan.end()) continue;
-    for (const auto& [q, x] : seen[p.feature])
-      if ((q->contact_mm - it->second->contact_mm).norm() < 1e-6) {
-        ss += std::pow(it->second->approach.normalized().dot(p.p_mm - x), 2);
-        ++r.pairs;
-      }
-    seen[p.feature].push_back({it->second, p.p_mm});
+    const double a = it->second->approach.normalized().dot(p.p_mm);
+    auto& v = groups[p.feature];
+    auto g = std::find_if(v.begin(), v.end(), [&](const Group& x) { return (x.where->contact_mm - it->second->contact_mm).norm() < 1e-6; });
+    if (g == v.end()) v.push_back({it->second, {a}});
+    else g->along.push_back(a);
   }
-  if (r.pairs > 0) r.s_um = std::sqrt(ss / (2.0 * r.pairs)) * 1e3;
+  SwRepeatability r;
+  double ss = 0;
+  for (const auto& [f, v] : groups)
+    for (const auto& g : v) {
+      if (g.along.size() < 2) continue;
+      double mean = 0;
+      for (double x : g.along) mean += x;
+      mean /= static_cast<double>(g.along.size());
+      for (double x : g.along) ss += (x - mean) * (x - mean);
+      r.pairs += static_cast<int>(g.along.size()) - 1;
+    }
+  if (r.pairs > 0) r.s_um = std::sqrt(ss / r.pairs) * 1e3;
   return r;
 }
 
@@ -191,11 +203,15 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoi
   const double d_probe = 2 * m.tip_radius_mm, d_tool = m.sw.tool_diameter_mm;
   auto count = [](const SwSourceGeometry& g, const std::string& id) { return plane(g, id).points; };
 
+  if (e.probe.steps.empty() || e.cmm.steps.size() != e.probe.steps.size())
+    throw InputError(m.file, 0, "stepped_workpiece.sizes_mm: no steps to evaluate");
   std::vector<std::array<Budget, 3>> pos;  // per step: x, y, z
+  std::vector<std::array<double, 3>> u_own;  // per step: the part of u_c that is the step's own (not a common scale)
   for (std::size_t i = 0; i < e.probe.steps.size(); ++i) {
     const auto &c = e.cmm.steps[i], &p = e.probe.steps[i];
     const int k = c.step;
     std::array<Budget, 3> b;
+    std::array<double, 3> own{};
     const char* axes[3] = {"x", "y", "z"};
     for (int a = 0; a < 3; ++a) {
       const double value = a == 0 ? c.width_x_error_um() - p.width_x_error_um()
@@ -216,32 +232,48 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoi
           contribution("part temperature on the machine", 'B', "rectangular",
                        "20 C +- " + formatNumber(kMachinePartHalfWidthK) + " K (not measured)", alpha * L * kMachinePartHalfWidthK / kSqrt3)};
       b[a] = uncertainty::combine(std::string("e_pos_") + axes[a] + "_um", "um", value, cs);
+      own[a] = std::sqrt(std::pow(cs[0].u, 2) + std::pow(cs[2].u, 2) + std::pow(m.sw.cmm.mpe_constant_um / kSqrt3, 2));
     }
     pos.push_back(b);
+    u_own.push_back(own);
   }
-  // e_pos(L) = k L per axis, weighted by 1/u_c^2; u(k) from the weights, scaled up by the
-  // Birge ratio when the steps scatter more than their budgets allow.
+  // e_pos(L) = k L per axis over the probe centre's travel (the steps are bosses: the ball
+  // touches each wall from outside, so its centre travels size + stylus d; the depth for Z),
+  // weighted by the steps' own uncertainties (probe repeatability, the CMM's planes, the MPE's
+  // constant); u(k) from the weights, scaled up by the Birge ratio when the steps scatter more
+  // than that, plus the lines common to every step, which scale with L and so go into k whole:
+  // the part's temperature at the CMM and on the machine and the MPE's length term.
   Budget* kb[3] = {&e.k_pos_x_um_per_mm, &e.k_pos_y_um_per_mm, &e.k_pos_z_um_per_mm};
   for (int a = 0; a < 3; ++a) {
     double swl2 = 0, swle = 0;
     std::vector<std::pair<double, double>> le;
     for (std::size_t i = 0; i < pos.size(); ++i) {
-      const double L = a < 2 ? e.probe.steps[i].size_mm - d_probe : e.probe.steps[i].depth_nominal_mm;
-      const double w = 1.0 / std::pow(pos[i][a].u_c, 2);
+      const double L = a < 2 ? e.probe.steps[i].size_mm + d_probe : e.probe.steps[i].depth_nominal_mm;
+      if (!(u_own[i][a] > 0))
+        throw GeometryError(m.file + ": step " + std::to_string(i + 1) + ": e_pos has no uncertainty of its own (no probe "
+                            "repeatability, no CMM specification): the steps cannot be weighted");
+      const double w = 1.0 / std::pow(u_own[i][a], 2);
       swl2 += w * L * L;
       swle += w * L * pos[i][a].value;
       le.push_back({L, pos[i][a].value});
     }
     const double k = swle / swl2;
     double chi2 = 0;
-    for (std::size_t i = 0; i < le.size(); ++i) chi2 += std::pow(le[i].second - k * le[i].first, 2) / std::pow(pos[i][a].u_c, 2);
+    for (std::size_t i = 0; i < le.size(); ++i) chi2 += std::pow(le[i].second - k * le[i].first, 2) / std::pow(u_own[i][a], 2);
     const int dof = static_cast<int>(le.size()) - 1;
     const double birge = dof > 0 ? std::max(1.0, std::sqrt(chi2 / dof)) : 1.0;
-    *kb[a] = uncertainty::combine(std::string("k_pos_") + "xyz"[a] + "_um_per_mm", "um/mm", k,
-                                  {contribution("e_pos of the steps", 'A', "normal",
-                                                "weighted line through 0 over " + std::to_string(le.size()) + " steps, Birge ratio " +
-                                                    formatNumber(birge, 3),
-                                                birge / std::sqrt(swl2), std::max(1, dof))});
+    std::vector<Contribution> cs{
+        contribution("e_pos of the steps", 'A', "normal",
+                     "weighted line through 0 over " + std::to_string(le.size()) + " steps, Birge ratio " + formatNumber(birge, 3),
+                     birge / std::sqrt(swl2), std::max(1, dof)),
+        contribution("part temperature at the CMM (every step alike)", 'B', "rectangular",
+                     "20 C +- " + formatNumber(dT_cmm) + " K, not corrected", alpha * dT_cmm / kSqrt3),
+        contribution("part temperature on the machine (every step alike)", 'B', "rectangular",
+                     "20 C +- " + formatNumber(kMachinePartHalfWidthK) + " K (not measured)", alpha * kMachinePartHalfWidthK / kSqrt3)};
+    if (m.sw.cmm.mpe_length_mm > 0)
+      cs.push_back(contribution("CMM MPE length term (every step alike)", 'B', "rectangular",
+                                "L / " + formatNumber(m.sw.cmm.mpe_length_mm) + " um", 1.0 / m.sw.cmm.mpe_length_mm / kSqrt3));
+    *kb[a] = uncertainty::combine(std::string("k_pos_") + "xyz"[a] + "_um_per_mm", "um/mm", k, cs);
   }
   for (std::size_t i = 0; i < e.probe.steps.size(); ++i) {
     const auto& p = e.probe.steps[i];
@@ -264,7 +296,7 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoi
       applied[1] = c.wall_um[2] + c.wall_um[3];
       applied[2] = c.floor_um;
     }
-    s.travel_probe_mm = p.size_mm - d_probe;
+    s.travel_probe_mm = p.size_mm + d_probe;
     s.travel_tool_mm = p.size_mm + d_tool;
     s.e_pos_x_um = pos[i][0];
     s.e_pos_y_um = pos[i][1];
@@ -272,11 +304,11 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoi
     for (int a = 0; a < 2; ++a) {
       const double we = a == 0 ? p.width_x_error_um() : p.width_y_error_um();
       const Budget& kk = *kb[a];
-      const double lever = d_tool + d_probe;  // e_pos over the tool's travel minus over the probe's
+      const double lever = d_tool - d_probe;  // e_pos over the tool's travel minus over the probe's
       const int n1 = count(e.probe, stepId(k, a == 0 ? "XP" : "YP")), n2 = count(e.probe, stepId(k, a == 0 ? "XN" : "YN"));
       std::vector<Contribution> cs{
           contribution("probe repeatability", type_a ? 'A' : 'B', "normal", rep_basis, s_pt * std::sqrt(1.0 / n1 + 1.0 / n2), dof_pt),
-          contribution("e_pos slope k", 'A', "normal", "u(k) x (tool d + stylus d) = " + formatNumber(lever) + " mm", kk.u_c * lever,
+          contribution("e_pos slope k", 'A', "normal", "u(k) x (tool d - stylus d) = " + formatNumber(lever) + " mm", kk.u_c * lever,
                        kk.contributions.empty() ? 1 : kk.contributions.front().dof),
           contribution("part temperature on the machine", 'B', "rectangular",
                        "20 C +- " + formatNumber(kMachinePartHalfWidthK) + " K (not measured)", alpha * p.size_mm * kMachinePartHalfWidthK / kSqrt3)};
@@ -294,7 +326,7 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoi
                       alpha * p.depth_nominal_mm * kMachinePartHalfWidthK / kSqrt3)});
     // Prediction: the same quantities by routes whose contributions are independent.
     for (int a = 0; a < 3; ++a) {
-      const double L = a < 2 ? p.size_mm - d_probe : p.depth_nominal_mm;
+      const double L = a < 2 ? p.size_mm + d_probe : p.depth_nominal_mm;
       const double probe_err = a == 0 ? p.width_x_error_um() : a == 1 ? p.width_y_error_um() : p.depth_error_um();
       const Budget& kk = *kb[a];
       const int n1 = count(e.probe, a == 0 ? stepId(k, "XP") : a == 1 ? stepId(k, "YP") : std::string("TOP"));

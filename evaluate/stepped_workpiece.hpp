@@ -5,26 +5,29 @@
 // Geometry (per source, CMM and probe): a least-squares plane per wall, floor and the top
 // (geometry::fitElement); per step the face-to-face widths X and Y at the wall's mid-height
 // (the planes evaluated at the step's centre line), the depth of its floor below the top (both
-// planes at the floor points' centroid), the walls' inclination dx/dz, dy/dz (the lean outward
-// positive), the floor's slopes dz/dx, dz/dy and Oz, the squareness of the X walls to the Y
-// walls (the angle between their normals minus 90 deg, positive when it is larger).
+// planes at the floor's nominal centre, the same place for both routes), the walls' tilt dx/dz,
+// dy/dz (the mean of the two walls: a tilted path tilts both the same way), the floor's slopes
+// dz/dx, dz/dy and Oz, the squareness of the X walls to the Y walls (the angle between their
+// normals minus 90 deg, positive when it is larger).
 //
 // Separation (both sources; seed 000 Sec. 3.3-3.6):
 // - e_pos (L761: CMM - probe): per step and axis, CMM width - probe width; it belongs to the
-//   distance the probe's centre travelled between the walls (size - stylus diameter, the
-//   thesis's "offset distance ... incorporated", L769). Z: CMM depth - probe depth, over the
-//   depth. A straight line through zero per axis, e_pos(L) = k L, weighted least squares.
+//   distance the probe's centre travelled between the walls: the steps are bosses, the ball
+//   touches each wall from outside, so size + stylus diameter (the thesis's "offset distance
+//   ... incorporated", L769). Z: CMM depth - probe depth, over the depth. A straight line
+//   through zero per axis, e_pos(L) = k L, weighted by each step's own uncertainty; the lines
+//   common to all steps (the part's temperature, the MPE's length term) go into u(k) whole.
 // - e_proc (L1629, a two-wall sum): probe width error - (e_pos over the tool centre's travel,
-//   size + tool diameter, minus e_pos over the probe's, size - stylus diameter) - the thermal
-//   position error, which one workpiece cannot separate: taken as 0 with its own budget line
-//   left to a W1 campaign (stated in the output). Per wall: half (L1639).
+//   size + tool diameter, minus e_pos over the probe's, size + stylus diameter) - the thermal
+//   position error, which one workpiece cannot separate: taken as 0 (stated in the output;
+//   a W1 campaign gives it). Per wall: half (L1639).
 // - e_splz (Sec. 3.5, L812): the floor's depth error from the probe: the spindle's growth
 //   between the top's cut and the floor's (+ when the floor lies shallower, i.e. the tool tip
 //   rose), with the cut times of the manifest.
-// Budgets: probe repeatability (from the repeated points, type A; else the manifest's 2 sigma,
-// type B), the CMM's MPE (rectangular), the part's temperature (CMM: the manifest's +-half
-// width; on the machine: +-1 K about 20 C, our assumption, rectangular), the planes' fit
-// residuals, and for e_proc the line's u(k).
+// Budgets: probe repeatability (pooled over the repeated points, type A; else the manifest's
+// 2 sigma, type B), the CMM's MPE (rectangular), the planes' fit residuals, the part's
+// temperature (CMM: the manifest's +-half width; on the machine: +-1 K about 20 C, our
+// assumption, rectangular), and for e_proc the line's u(k).
 //
 // Contract: InputError (file, line, feature) for what cannot be read or a feature with fewer
 // than 3 points; GeometryError never escapes as a NaN: a degenerate plane is refused naming it.
@@ -51,7 +54,7 @@ struct SwStepGeometry {
   double size_mm = 0, depth_nominal_mm = 0;
   double width_x_mm = 0, width_y_mm = 0, depth_mm = 0;
   double u_wall_x_um = 0, u_wall_y_um = 0, u_depth_um = 0;  // from the fits' residuals
-  double lean_x_urad = 0, lean_y_urad = 0;                  // mean outward lean of the X and Y walls
+  double lean_x_urad = 0, lean_y_urad = 0;                  // tilt dx/dz (dy/dz) of the X (Y) walls, their mean
   double floor_slope_x_urad = 0, floor_slope_y_urad = 0;    // dz/dx, dz/dy of the floor
   double oz_urad = 0;
   double width_x_error_um() const { return (width_x_mm - size_mm) * 1e3; }
@@ -68,12 +71,12 @@ struct SwSourceGeometry {
 struct SwStepSeparation {
   int step = 0;
   double feed_mm_per_min = 0, spindle_rpm = 0, temp_state_min = 0;
-  double travel_probe_mm = 0, travel_tool_mm = 0;  // size - stylus d, size + tool d
+  double travel_probe_mm = 0, travel_tool_mm = 0;  // size + stylus d, size + tool d
   uncertainty::Budget e_pos_x_um, e_pos_y_um, e_pos_z_um;
   uncertainty::Budget e_proc_x_um, e_proc_y_um;  // two-wall sums (L1639: half per wall)
   uncertainty::Budget e_splz_um;
   // Prediction for this experiment cut again (Ch. 6): the CMM width errors, e_pos over the
-  // tool's travel + e_proc (+ e_pt, 0 from one part), i.e. probe width error + k (size - stylus
+  // tool's travel + e_proc (+ e_pt, 0 from one part), i.e. probe width error + k (size + stylus
   // d); the CMM depth error, probe depth error + k_z depth. Independent contributions only.
   uncertainty::Budget predicted_width_x_um, predicted_width_y_um, predicted_depth_um;
 };
@@ -105,7 +108,7 @@ SwSourceGeometry steppedGeometry(const parts::PlanManifest& m, const TtpPoints& 
 // The manifest's repeated probe points (same feature, same nominal contact): s of one point.
 struct SwRepeatability {
   double s_um = 0;
-  int pairs = 0;
+  int pairs = 0;  // degrees of freedom: sum over the repeated places of (touches - 1)
 };
 SwRepeatability probeRepeatability(const parts::PlanManifest& m, const TtpPoints& probe);
 

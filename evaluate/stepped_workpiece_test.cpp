@@ -115,44 +115,50 @@ TEST(SteppedWorkpieceGeometry, WidthsDepthsTiltsAndSquarenessOfKnownPlanes) {
   }
 }
 
-TEST(SteppedWorkpieceSeparation, PositionErrorIsCmmMinusProbeAndProcessTheRest) {
+// A machine whose X axis is long by c (a scale error about the steps' centre, x_real = x +
+// c (x - 15)) cuts each X wall with the tool's centre at h + r_tool from the centre and the tool
+// pushed delta/2 outward: the walls stand at 15 +- (h + c (h + r_tool) + delta/2), which the
+// CMM sees. The probe's ball touches each wall from outside with the same long axis: it reports
+// the surface where its commanded centre, made long by c, meets the wall, minus its radius.
+// Solved exactly here (not to first order), so:
+//   CMM - probe = c (width + d_probe) -> k = c (every step alike),
+//   probe width error = delta + c (d_tool - d_probe) (first order) -> e_proc = delta.
+TEST(SteppedWorkpieceSeparation, PositionErrorAndProcessErrorOfALongAxis) {
   auto m = twoSteps();
-  // The CMM sees the walls 0.2 um per mm of size farther out than the probe (e_pos over the
-  // probe's travel, size - 2 mm: the line through 0 has k = 0.2 * size / (size - 2) per step,
-  // which differs between steps: the weighted k lies between 0.2 * 30/28 and 0.2 * 45/43);
-  // the probe sees widths +4 um (30) and +6 um (45).
-  Surfaces probe_s, cmm_s;
-  const auto probe_pts = [&] {
-    TtpPoints t = pointsOn(m, probe_s, "probe.log");
-    // widths +4 / +6 um: move the walls 2 / 3 um out per step
-    for (auto& p : t.points) {
-      const double out = p.feature.rfind("S1_", 0) == 0 ? 2e-3 : p.feature.rfind("S2_", 0) == 0 ? 3e-3 : 0;
-      if (p.feature.find("XP") != std::string::npos) p.p_mm.x() += out;
-      if (p.feature.find("XN") != std::string::npos) p.p_mm.x() -= out;
+  const double c = 0.2e-3, r_tool = 5, r_probe = 1;
+  const double delta_mm[2] = {3e-3, 5e-3};
+  TtpPoints cmm = pointsOn(m, {}, "cmm.csv"), probe = pointsOn(m, {}, "probe.log");
+  for (auto* t : {&cmm, &probe})
+    for (auto& p : t->points) {
+      const int k = p.feature.rfind("S1_", 0) == 0 ? 0 : p.feature.rfind("S2_", 0) == 0 ? 1 : -1;
+      const bool xp = p.feature.find("XP") != std::string::npos, xn = p.feature.find("XN") != std::string::npos;
+      if (k < 0 || !(xp || xn)) continue;
+      const double h = m.sw.sizes_mm[static_cast<std::size_t>(k)] / 2, side = xp ? 1.0 : -1.0;
+      const double wall = 15 + side * (h + c * (h + r_tool) + delta_mm[k] / 2);  // as cut
+      if (t == &cmm) {
+        p.p_mm.x() = wall;
+      } else {
+        const double centre = (wall + side * r_probe + 15 * c) / (1 + c);  // commanded, the real one touching
+        p.p_mm.x() = centre - side * r_probe;
+      }
     }
-    return t;
-  }();
-  TtpPoints cmm_pts = probe_pts;
-  cmm_pts.file = "cmm.csv";
-  for (auto& p : cmm_pts.points) {
-    const double size = p.feature.rfind("S1_", 0) == 0 ? 30 : 45;
-    if (p.feature.find("XP") != std::string::npos) p.p_mm.x() += 0.1e-3 * size;
-    if (p.feature.find("XN") != std::string::npos) p.p_mm.x() -= 0.1e-3 * size;
-  }
-  const auto e = evaluateSteppedWorkpiece(m, cmm_pts, probe_pts);
+  const auto e = evaluateSteppedWorkpiece(m, cmm, probe);
   ASSERT_EQ(e.steps.size(), 2u);
-  EXPECT_NEAR(e.steps[0].e_pos_x_um.value, 6.0, 1e-6);  // 0.2 um/mm x 30 mm
-  EXPECT_NEAR(e.steps[1].e_pos_x_um.value, 9.0, 1e-6);
-  EXPECT_NEAR(e.steps[0].e_pos_y_um.value, 0.0, 1e-6);
-  const double k = e.k_pos_x_um_per_mm.value;
-  EXPECT_GT(k, 0.2 * 45 / 43 - 1e-9);
-  EXPECT_LT(k, 0.2 * 30 / 28 + 1e-9);
-  // e_proc = probe width error - k (tool d + stylus d) = 4 - 12 k, 6 - 12 k
-  EXPECT_NEAR(e.steps[0].e_proc_x_um.value, 4.0 - 12 * k, 1e-6);
-  EXPECT_NEAR(e.steps[1].e_proc_x_um.value, 6.0 - 12 * k, 1e-6);
+  EXPECT_NEAR(e.k_pos_x_um_per_mm.value, c * 1e3, 1e-4);  // to second order in c (c^2 = 4e-5 um/mm)
+  for (int k = 0; k < 2; ++k) {
+    const double size = m.sw.sizes_mm[static_cast<std::size_t>(k)];
+    EXPECT_NEAR(e.steps[static_cast<std::size_t>(k)].e_pos_x_um.value, c * (size + 2 * r_probe) * 1e3, 0.01) << k;
+    EXPECT_NEAR(e.steps[static_cast<std::size_t>(k)].e_proc_x_um.value, delta_mm[k] * 1e3, 0.01) << k;
+    // The CMM error a re-cut is predicted to have: c (size + d_tool) + delta.
+    EXPECT_NEAR(e.steps[static_cast<std::size_t>(k)].predicted_width_x_um.value, (c * (size + 2 * r_tool) + delta_mm[k]) * 1e3, 0.01) << k;
+    EXPECT_NEAR(e.steps[static_cast<std::size_t>(k)].e_pos_y_um.value, 0.0, 1e-6);
+  }
   EXPECT_EQ(e.probe_repeat_pairs, 0);  // no repeats: the manifest's 2 sigma / 2
   EXPECT_DOUBLE_EQ(e.probe_repeatability_um, 1.0);
-  EXPECT_GT(e.steps[1].e_pos_x_um.U, 0);
+  // u(k) holds the part's temperature whole (alpha x 1 K / sqrt 3 on the machine, 0.5 K at the
+  // CMM), which the steps' scatter cannot reveal.
+  const double alpha = 23.4e-3;  // um per mm per K
+  EXPECT_GT(e.k_pos_x_um_per_mm.u_c, std::hypot(alpha / std::sqrt(3.0), alpha * 0.5 / std::sqrt(3.0)) - 1e-12);
 }
 
 TEST(SteppedWorkpieceSeparation, RepeatabilityFromRepeatedPlannedPoints) {
@@ -171,6 +177,15 @@ TEST(SteppedWorkpieceSeparation, RepeatabilityFromRepeatedPlannedPoints) {
   const auto r = probeRepeatability(m, t);
   EXPECT_EQ(r.pairs, 1);
   EXPECT_NEAR(r.s_um, 1.2 / std::sqrt(2.0), 1e-9);  // s of one point from one difference d: |d| / sqrt 2
+  // A third touch of the same place: 2 degrees of freedom, s from the deviations from the mean
+  // (0, 1.2, 0.3 um: mean 0.5, squares 0.25 + 0.49 + 0.04 = 0.78, s = sqrt(0.78 / 2)).
+  parts::ManifestPoint c3 = a;
+  c3.point = 3;
+  m.points.push_back(c3);
+  t.points.push_back({"S1_XP", 3, 3, {30.0 + 0.3e-3, 15, -4}});
+  const auto r3 = probeRepeatability(m, t);
+  EXPECT_EQ(r3.pairs, 2);
+  EXPECT_NEAR(r3.s_um, std::sqrt(0.78 / 2), 1e-9);
 }
 
 TEST(SteppedWorkpieceSeparation, MissingFeaturesAndOtherKindsAreRefused) {

@@ -265,6 +265,58 @@ void expectRefusal(const std::string& prog, const std::string& want) {
   }
 }
 
+// Straight up from a floor just cut is allowed (the start may rest 2 um in the neighbouring
+// floor), but a tool 0.3 mm longer than the active length offset starts 0.3 mm inside the
+// floor: the retract is refused, though its end is clear.
+TEST(Machining, RetractStraightUpFromInsideTheFloorIsCaught) {
+  auto w = block(0.0);
+  auto longer = w.tools[0];
+  longer.number = 2;
+  longer.length_mm += 0.3;
+  w.tools.push_back(longer);
+  const std::string cut = "G21 G90\nT1 M6\nG43 H1\nS5000 M3\nG0 X-60 Y0 Z60\nG0 Z38\nG1 X0 F500\n";
+  EXPECT_NO_THROW(machine(truthFrom(""), w, cut + "G0 Z60\nM5\nM2\n", {}));
+  try {
+    machine(truthFrom(""), w, cut + "M5\nT2 M6\nG0 Z60\nM2\n", {});
+    FAIL() << "accepted a retract that starts 0.3 mm inside the floor";
+  } catch (const SafetyError& e) {
+    EXPECT_NE(std::string(e.what()).find("mill.ngc:10: rapid (G0) would move through the workpiece's material"), std::string::npos)
+        << e.what();
+  }
+}
+
+// Between programs with planned starts the machine is off: the spindle node cools toward the
+// hall as its first-order law says (tau = C / G = 8e4 / 20 = 4000 s), with the spindle still.
+TEST(Machining, TheMachineCoolsWhileOffBetweenPlannedPrograms) {
+  const auto truth = truthFrom(
+      "thermal:\n  environment: {mean_C: 20}\n  nodes:\n    - {name: spindle, capacity_J_per_K: 8.0e4, to_environment_W_per_K: 20}\n"
+      "  sources:\n    - {node: spindle, input: spindle_speed, W_per_rpm: 0.02}\n"
+      "  sensors:\n    - {column: T_spindle_C, node: spindle, noise_K: 0}\ninputs_rate: 10 s\n");
+  const auto m = parts::loadMachine(src("parts/machines/linuxcnc_rotary_mill.yaml"));
+  auto w = block(0.0);
+  SimulationPart part;
+  part.workpiece = &w;
+  const std::string warm = "G21 G90\nT1 M6\nG43 H1\nS8000 M3\nG4 P3600\nM5\nM2\n", later = "G21 G90\nG4 P10\nM2\n";
+  const auto out = simulatePrograms({{"warm.ngc", warm, 0.0}, {"later.ngc", later, 6.0 * 3600}}, m, part, truth, 1);
+  EXPECT_NEAR(out.end_time_s, 6.0 * 3600 + 10, 1e-6);
+  const CsvTable t = parseCsv(out.inputs_csv, "inputs");
+  const int ct = t.column("T_spindle_C"), cs = t.column("spindle_rpm"), ctime = t.column("time_s");
+  double Ta = NAN, Tb = NAN;
+  for (const auto& row : t.rows) {
+    const double time = t.number(row, ctime);
+    if (time > 3700 && time < 6.0 * 3600) {
+      EXPECT_EQ(t.number(row, cs), 0.0) << time;
+    }
+    if (std::fabs(time - 7200) < 1e-6) Ta = t.number(row, ct);
+    if (std::fabs(time - 14400) < 1e-6) Tb = t.number(row, ct);
+  }
+  ASSERT_TRUE(std::isfinite(Ta) && std::isfinite(Tb));
+  EXPECT_GT(Ta - 20, 1.0);  // warmed by the hour at 8000 rpm (160 W)
+  EXPECT_NEAR(Tb - 20, (Ta - 20) * std::exp(-7200.0 / 4000.0), 2e-3);  // inputs.csv prints 3 decimals
+  // Programs given out of their planned order are refused.
+  EXPECT_THROW(simulatePrograms({{"later.ngc", later, 6.0 * 3600}, {"warm.ngc", warm, 0.0}}, m, part, truth, 1), InputError);
+}
+
 TEST(Machining, UnsafeMovesNameTheirLine) {
   const std::string head = "G21 G90\nT1 M6\nG43 H1\n";
   expectRefusal(head + "G0 X0 Y0 Z60\nG0 Z30\n", "mill.ngc:5: rapid (G0) would move through the workpiece's material");

@@ -356,14 +356,16 @@ class VirtualMachine : public gcode::MachineInterface {
   }
 
   // The machine switched off for s seconds between programs (seed 000 L992: 3 h off before
-  // machining and before probing): spindle, coolant and axes still, the structure cooling
-  // toward the hall; no load from the duty profile (that runs only while a program dwells).
+  // machining and before probing): spindle, coolant (and the duty's coolant profile), axes, C
+  // and constant heat sources off, the structure cooling toward the hall.
   void machineOff(double s) {
     spindle_rpm_ = 0;
     coolant_ = false;
     path_speed_mm_per_min_ = 0;
     const double t0 = t_;
+    off_ = true;
     advance(s);
+    off_ = false;
     traceRow("machine_off", pos_, 0, t0);
   }
 
@@ -407,6 +409,7 @@ class VirtualMachine : public gcode::MachineInterface {
   Vector3d atc_um_ = Vector3d::Zero();
   double spindle_rpm_ = 0;
   double path_speed_mm_per_min_ = 0;
+  bool off_ = false;  // machineOff: every heat input off
   double c_move_rpm_ = 0;  // C speed while a feed move turns it
   bool coolant_ = false, dwelling_ = false;
   int tool_changes_ = 0;
@@ -473,6 +476,7 @@ class VirtualMachine : public gcode::MachineInterface {
   }
 
   double cRpm(double t) {
+    if (off_) return 0;
     if (c_move_rpm_ > 0) return c_move_rpm_;  // a feed move turns C (the test's load)
     if (!dwelling_) return 0;
     const auto& d = tr_.duty;
@@ -491,6 +495,7 @@ class VirtualMachine : public gcode::MachineInterface {
     return 0;
   }
   bool mwfOn(double t) const {
+    if (off_) return false;
     bool on = coolant_;
     for (const auto& [at, v] : tr_.duty.mwf_profile)
       if (t >= at) on = v;
@@ -506,7 +511,7 @@ class VirtualMachine : public gcode::MachineInterface {
         case HeatInput::SpindleRpm: v = std::fabs(spindle_rpm_) * s.gain; break;
         case HeatInput::AxisSpeed: v = path_speed_mm_per_min_ / 1000.0 * s.gain; break;
         case HeatInput::Mwf: v = mwfOn(t) ? s.gain : 0.0; break;
-        case HeatInput::Constant: v = s.gain; break;
+        case HeatInput::Constant: v = off_ ? 0.0 : s.gain; break;
       }
       q(s.node) += v;
     }
@@ -843,14 +848,14 @@ class VirtualMachine : public gcode::MachineInterface {
 
   // Does the tool at gauge position g sit in material (height field)? For a flat end mill
   // the bottom disk; for the probe the tip ball's lower part (reach r/2, 0.866 r below).
-  bool inMaterial(const Vector3d& g) const {
+  bool inMaterial(const Vector3d& g, double tolerance_mm = 1e-6) const {
     const Vector3d w = toWorkpiece(tipActual(g));
     const double r = tipRadius();
     const bool ball = tool_ == m_.probe.tool;
     const double reach = ball ? 0.5 * r : std::max(0.0, r - 0.2);
     const double bottom = ball ? w.z() - 0.866 * r : w.z();
     if (bottom + 1e-6 >= stock_.max().z()) return false;  // above the stock: no cell can be higher
-    return stock_.topUnder(w.head<2>(), reach) > bottom + 1e-6;
+    return stock_.topUnder(w.head<2>(), reach) > bottom + tolerance_mm;
   }
 
   // The lowest point of what is in the spindle, below the tip (the probe's ball reaches r
@@ -941,16 +946,17 @@ class VirtualMachine : public gcode::MachineInterface {
     const Vector3d a = pos_.xyz_mm, b = to.xyz_mm;
     if (to.c_deg != pos_.c_deg && a != b) checkTogetherWithC(to, what);
     const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / 0.5)));
-    // Straight up from where the tool stands: its start is where the last feed move left it,
-    // resting on (and, with axis errors that vary along X/Y, by a fraction of a micrometre in)
-    // the floor that neighbouring passes cut; rising, the same footprint only leaves material.
+    // Straight up from where the tool stands: it rests on the floor the last feed move cut and,
+    // where the axes' Z errors vary along X/Y, sits a fraction of a micrometre in the floor
+    // that neighbouring passes cut: the start tolerates 2 um of it (a tool 0.3 mm too long
+    // after a tool change is still caught); rising, the same footprint only leaves material.
     const bool straight_up = b.z() > a.z() && b.head<2>() == a.head<2>() && to.c_deg == pos_.c_deg;
-    for (int k = straight_up ? 1 : 0; k <= n; ++k) {
+    for (int k = 0; k <= n; ++k) {
       const Vector3d g = a + (b - a) * (static_cast<double>(k) / n);
       const Vector3d tip = tipActual(g);
       if (tip.z() - (tool_ == m_.probe.tool ? tipRadius() : 0.0) < m_.table_surface_z_mm - 1e-9)
         throw SafetyError(what + " would hit the table at tip Z " + formatNumber(tip.z(), 4) + " mm");
-      if (inMaterial(g)) {
+      if (inMaterial(g, straight_up && k == 0 ? 2e-3 : 1e-6)) {
         const Vector3d w = toWorkpiece(tip);
         throw SafetyError(what + " would move through the workpiece's material at X " + formatNumber(w.x(), 3) +
                           " Y " + formatNumber(w.y(), 3) + " Z " + formatNumber(w.z(), 3) + " (workpiece frame)");
@@ -1158,9 +1164,10 @@ class VirtualMachine : public gcode::MachineInterface {
       const Vector3d d = (b - a).normalized();
       // Distances in the workpiece frame (20 °C) -> machine travel.
       const double to_machine = len / (b - a).norm();
-      // The ball touches a surface square to the approach when its centre is r from it.
+      // The ball touches a surface square to the approach when its centre is r from it, in the
+      // workpiece frame (where the axes' errors stretch the path): (s - r) of real travel.
       if (const auto s = stock_.firstMaterial(a, d, (b - a).norm() + r / to_machine)) {
-        s_contact = *s * to_machine - r;
+        s_contact = (*s - r) * to_machine;
         if (s_contact < 0) {
           if (mode != gcode::ProbeMode::SkipToTarget)
             throw SafetyError("probe move starts with the probe already in contact (tripped)");
@@ -1297,7 +1304,12 @@ SimulationOutputs simulatePrograms(const std::vector<ProgramSource>& programs, c
   if (part.trace) vm.enableTrace(multi);
   SimulationOutputs out;
   bool last_fanuc = false;
+  std::optional<double> last_start;
   for (const auto& p : programs) {
+    if (p.start_s && last_start && *p.start_s < *last_start)
+      throw InputError(p.file, 0, "planned to start at " + formatNumber(*p.start_s, 1) + " s, before the program given before it (" +
+                                      formatNumber(*last_start, 1) + " s): give the programs in their planned order");
+    if (p.start_s) last_start = p.start_s;
     const gcode::ProgramDialect dialect = dialectOf(p.file, machine);
     last_fanuc = dialect == gcode::ProgramDialect::FanucMacroB;
     gcode::Interpreter interp(dialect, p.file, p.text);

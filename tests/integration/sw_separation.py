@@ -55,6 +55,7 @@ code, out, err = run("plan", PIECE, "--machine", VMC, "--out", plan_dir, "--expe
 check("plan W8", code == 0, err)
 manifest = json.load(open(f"{plan_dir}/plan.json"))
 feature_of = {p["position"]: p["feature"] for p in manifest["points"]}
+sizes_of = manifest["stepped_workpiece"]["sizes_mm"]
 truth_text = open(TRUTH).read()
 k_truth = {"x": coefficient(truth_text, "X", "EXX_um"), "y": coefficient(truth_text, "Y", "EYY_um"),
            "z": coefficient(truth_text, "Z", "EZZ_um")}
@@ -128,6 +129,34 @@ def as_cut_errors(feats, sizes, depths):
                     "depth": (feats["TOP"]["as_cut"]["point_mm"][2] - p("F", 2) - depths[k - 1]) * 1e3})
     return out
 
+
+# --- the measuring model alone: a long X axis, no noise -------------------------------------------
+# The probe's ball touches each wall from outside with the axis long by c: it reports the
+# surface less the axis error at its centre, so the probed width is the width as cut (truth.json)
+# less the contacts' axis errors (events[].axes_um), to the export's digits.
+open(f"{W}/long_x.yaml", "w").write("kind: machine_truth\naxes:\n  X: {EXX_um: [0, 0.15]}\n"
+                                    "structure: {stiffness_x_N_per_um: 3, stiffness_y_N_per_um: 3}\n")
+code, out, err = run("simulate", "roughing.ngc", "finishing.ngc", "probing.ngc", "--machine", VMC, "--part", PIECE, "--truth",
+                     f"{W}/long_x.yaml", "--cmm-points", "cmm_points.csv", "--schedule", "plan.json", "--out", f"{W}/run-long-x",
+                     cwd=plan_dir)
+code2, out, err2 = run("evaluate", f"{W}/run-long-x/cmm_export.csv", "--probe-log", f"{W}/run-long-x/sw_probe.log", "--manifest",
+                       f"{plan_dir}/plan.json", "--out", f"{W}/ev-long-x")
+if code == 0 and code2 == 0:
+    t = json.load(open(f"{W}/run-long-x/truth.json"))
+    ev = json.load(open(f"{W}/ev-long-x/evaluation.json"))
+    feats = {f["id"]: f for f in t["features"]}
+    axes = {}
+    for e in t["events"]:
+        axes.setdefault(feature_of[e["position"]], []).append(e["axes_um"][0])
+    worst = 0.0
+    for s in ev["on_machine"]["steps"]:
+        k = s["step"]
+        as_cut = (feats[f"S{k}_XP"]["as_cut"]["point_mm"][0] - feats[f"S{k}_XN"]["as_cut"]["point_mm"][0] - sizes_of[k - 1]) * 1e3
+        seen = sum(axes[f"S{k}_XP"]) / len(axes[f"S{k}_XP"]) - sum(axes[f"S{k}_XN"]) / len(axes[f"S{k}_XN"])
+        worst = max(worst, abs(s["width_x_error_um"] - (as_cut - seen)))
+    check(f"a long X axis, no noise: probed widths = as cut - the contacts' axis errors (worst {worst:.4f} um)", worst < 0.01, worst)
+else:
+    check("a long X axis, no noise: simulate and evaluate", False, err + err2)
 
 results = {}
 for seed in ("1", "7"):
