@@ -163,6 +163,22 @@ for seed in ("1", "7"):
     run_dir, ev_dir, _ = simulate_and_evaluate(f"seed {seed}", plan_dir, seed)
     results[seed] = (run_dir, ev_dir) + truth_recovery(f"seed {seed}", run_dir, ev_dir)
 
+# --- the Fanuc programs (DPRNT log) give the same separation as the LinuxCNC ones (same seed) ---------
+plan_f = f"{W}/plan-fanuc"
+code, out, err = run("plan", PIECE, "--machine", VMC, "--out", plan_f, "--experiment", "W8", "--dialect", "fanuc")
+code_s, out, err_s = run("simulate", "roughing.nc", "finishing.nc", "probing.nc", "--machine", VMC, "--part", PIECE, "--truth",
+                         TRUTH, "--cmm-points", "cmm_points.csv", "--schedule", "plan.json", "--out", f"{W}/run-fanuc", cwd=plan_f)
+code_e, out, err_e = run("evaluate", f"{W}/run-fanuc/cmm_export.csv", "--probe-log", f"{W}/run-fanuc/dprnt.txt", "--manifest",
+                         f"{plan_f}/plan.json", "--out", f"{W}/ev-fanuc")
+if code == 0 and code_s == 0 and code_e == 0:
+    fa = json.load(open(f"{W}/ev-fanuc/evaluation.json"))["separation"]
+    lc = json.load(open(f"{results['1'][1]}/evaluation.json"))["separation"]
+    keys = ("e_pos_x_um", "e_pos_y_um", "e_proc_x_um", "e_proc_y_um", "e_splz_um")
+    diff = max(abs(a[k]["value"] - b[k]["value"]) for a, b in zip(fa, lc) for k in keys)
+    check(f"Fanuc W8 (O3001-O3003, DPRNT) separates as LinuxCNC W8 does (max difference {diff:.2g} um)", diff < 1e-9, diff)
+else:
+    check("Fanuc W8: plan, simulate, evaluate the DPRNT log", False, err + err_s + err_e)
+
 # --- compensation (Ch. 6): the prediction of seed 1 taken out of the path, cut again (seed 2) ----
 run1, ev1, before_ev, before_feats = results["1"]
 comp = json.load(open(f"{ev1}/compensation.json"))
