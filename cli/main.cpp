@@ -18,6 +18,7 @@
 #include "evaluate/point_cloud.hpp"
 #include "evaluate/sphere_campaign.hpp"
 #include "evaluate/test_piece.hpp"
+#include "model/stepped_prediction.hpp"
 #include "parts/gum_model.hpp"
 #include "parts/machine.hpp"
 #include "parts/plan_manifest.hpp"
@@ -39,15 +40,60 @@ std::string join(const std::string& dir, const std::string& file) {
   return (fs::path(dir) / file).string();
 }
 
+// A stepped workpiece's compensation predicted for the planned experiment (seed 000 Ch. 6): the
+// experiment planned once for its conditions (each step's size, floor depth, feed, speed and
+// Temp state), the components of another part's evaluation summed there
+// (model/stepped_prediction.hpp); the offsets do not change the clock (micrometres).
+parts::SwCompensation predictedCompensation(const planner::TestPiecePlan& first, const std::string& evaluation_file) {
+  const auto& m = first.manifest;
+  if (m.kind != "stepped_workpiece")
+    throw InputError(evaluation_file, 0, "--predict-from: only a stepped workpiece's finishing takes a predicted compensation");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(readFile(evaluation_file));
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(evaluation_file, 0, std::string("not JSON: ") + e.what());
+  }
+  const auto predictor = model::steppedPredictorFromEvaluation(j, evaluation_file);
+  std::vector<model::SteppedConditions> conds;
+  for (std::size_t i = 0; i < m.sw.steps.size() && i < m.sw.sizes_mm.size(); ++i) {
+    const auto& s = m.sw.steps[i];
+    const auto* floor = m.feature("S" + std::to_string(s.step) + "_F");
+    if (!floor) throw InputError(m.file, 0, "features: no floor of step " + std::to_string(s.step));
+    conds.push_back({s.step, m.sw.sizes_mm[i], -floor->nominal.point_mm.z(), s.feed_xy_mm_per_min, s.spindle_speed_rpm, s.temp_state_min});
+  }
+  parts::SwCompensation c;
+  c.file = evaluation_file;
+  c.experiment = m.sw.experiment;
+  c.basis = model::steppedPredictorSummary(predictor);
+  for (const auto& p : model::predictSteppedErrors(predictor, conds)) {
+    parts::SwStepCompensation x;
+    x.step = p.step;
+    x.wall_um = {p.width_x_um / 2, p.width_x_um / 2, p.width_y_um / 2, p.width_y_um / 2};
+    x.U_wall_um = {p.U_width_x_um / 2, p.U_width_x_um / 2, p.U_width_y_um / 2, p.U_width_y_um / 2};
+    x.floor_um = p.depth_um;
+    x.U_floor_um = p.U_depth_um;
+    c.steps.push_back(x);
+  }
+  return c;
+}
+
 int cmdPlan(const std::string& piece_file, const std::string& machine_file, const std::string& out_dir,
-            const std::string& dialect_opt, const std::string& experiment, const std::string& compensation_file) {
+            const std::string& dialect_opt, const std::string& experiment, const std::string& compensation_file,
+            const std::string& predict_from) {
   const auto piece = parts::loadTestPiece(piece_file);
   std::optional<parts::SwCompensation> comp;
+  if (!compensation_file.empty() && !predict_from.empty())
+    throw InputError(predict_from, 0, "--predict-from and --compensate: give one (a prediction, or offsets already predicted)");
   if (!compensation_file.empty()) comp = parts::loadSwCompensation(compensation_file);
   const auto machine = parts::loadMachine(machine_file);
   const bool linux = dialect_opt == "linuxcnc" || (dialect_opt == "machine" && machine.dialect == parts::Dialect::LinuxCnc);
-  const auto plan = planner::planTestPiece(piece, machine, linux ? parts::Dialect::LinuxCnc : parts::Dialect::FanucMacroB,
-                                           out_dir, experiment, comp ? &*comp : nullptr);
+  const auto dialect = linux ? parts::Dialect::LinuxCnc : parts::Dialect::FanucMacroB;
+  if (!predict_from.empty()) {
+    comp = predictedCompensation(planner::planTestPiece(piece, machine, dialect, out_dir, experiment), predict_from);
+    std::fputs(comp->basis.c_str(), stdout);
+  }
+  const auto plan = planner::planTestPiece(piece, machine, dialect, out_dir, experiment, comp ? &*comp : nullptr);
   // Everything is planned and checked before the first file is written.
   for (const auto& p : plan.programs) writeFileAtomic(join(out_dir, p.file), p.text);
   for (const auto& [name, content] : plan.files) writeFileAtomic(join(out_dir, name), content);
@@ -272,6 +318,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"machine", "linuxcnc", "fanuc"}))->capture_default_str();
   plan->add_option("--experiment", experiment, "stepped workpiece: the experiment to plan (W1 ... W8, Table 4.1)");
   std::string compensate;
+  std::string predict_from;
+  plan->add_option("--predict-from", predict_from, "stepped workpiece: another part's evaluation.json; its separated components, "
+                   "fitted against feed and Temp state, predict this experiment's wall and floor errors, which the finishing "
+                   "path takes out (seed 000 Ch. 6)")->check(CLI::ExistingFile);
   plan->add_option("--compensate", compensate, "stepped workpiece: compensation.json (from evaluate): the predicted wall and "
                    "floor errors taken out of the finishing path (seed 000 Ch. 6)")->check(CLI::ExistingFile);
 
@@ -367,7 +417,7 @@ int main(int argc, char** argv) {
   try {
     if (*model_group) return run_model();
     if (*report_group) return run_report();
-    if (*plan) return cmdPlan(artifact, machine, out, dialect, experiment, compensate);
+    if (*plan) return cmdPlan(artifact, machine, out, dialect, experiment, compensate, predict_from);
     if (*res) return cmdResolution(artifact, machine, step_um);
     if (*syn) return cmdSynth(manifest, truth, out, seed);
     if (*simc) return cmdSimulate(sim_programs, machine, part, truth, out, seed, cmm_points, sim_trace, schedule);

@@ -69,7 +69,8 @@ def simulate_and_evaluate(label, plan_dir, seed, compare=None):
     check(f"{label}: simulate W8 with the plan's schedule", code == 0, err)
     hours = re.search(r"([\d.]+) h of machine time", out)
     # roughing + 3 h off + finishing + 3 h off + probing (plan.json's clock)
-    planned_h = (manifest["programs"][-1]["start_s"] + manifest["programs"][-1]["duration_s"]) / 3600
+    progs = json.load(open(f"{plan_dir}/plan.json"))["programs"]
+    planned_h = (progs[-1]["start_s"] + progs[-1]["duration_s"]) / 3600
     check(f"{label}: the machine-off waits are simulated ({hours.group(1) if hours else '?'} h, planned {planned_h:.2f} h)",
           hours and abs(float(hours.group(1)) - planned_h) < 0.15, out)
     args = ["evaluate", f"{run_dir}/cmm_export.csv", "--probe-log", f"{run_dir}/sw_probe.log", "--manifest",
@@ -203,7 +204,43 @@ for k in range(1, 5):
         fall = tb[k - 1][q] - ta[k - 1][q]
         check(f"step {k} {q}: the surfaces as cut fell {fall:.2f} um, promised {x['promised_um']:.2f} +- {x['U_promised_um']:.2f}",
               abs(fall - x["promised_um"]) <= x["U_promised_um"], x)
+        check(f"step {k} {q}: predicted {x['promised_um']:.2f} um, the part's error as cut {tb[k - 1][q]:.2f}, "
+              f"the compensated part's {ta[k - 1][q]:.2f}",
+              abs(tb[k - 1][q] - x["promised_um"]) <= x["U_promised_um"] and abs(ta[k - 1][q]) <= x["U_promised_um"], x)
 rms = lambda key: (sum(x[key] ** 2 for x in ba.values()) / len(ba)) ** 0.5
+# --- prediction for another experiment (Ch. 6): W1 (feed 100 throughout, other Temp states) from
+# the families fitted to W8's components; W1 cut plain and compensated, the fall per feature ------
+plan_w1, plan_w1c = f"{W}/plan-w1", f"{W}/plan-w1-predicted"
+code, out, err = run("plan", PIECE, "--machine", VMC, "--out", plan_w1, "--experiment", "W1")
+check("plan W1", code == 0, err)
+code, out, err = run("plan", PIECE, "--machine", VMC, "--out", plan_w1c, "--experiment", "W1", "--predict-from", f"{ev1}/evaluation.json")
+check("plan W1 --predict-from W8's evaluation: the families chosen are printed",
+      code == 0 and "e_proc_x_um(feed_mm_per_min)" in out and "e_splz_um(temp_state_min)" in out, err or out)
+if code == 0:
+    w1 = json.load(open(f"{plan_w1}/plan.json"))
+    run_b, ev_b, _ = simulate_and_evaluate("W1 plain", plan_w1, "3")
+    run_a, ev_a, out = simulate_and_evaluate("W1 predicted", plan_w1c, "3", compare=f"{ev_b}/evaluation.json")
+    fb = {f["id"]: f for f in json.load(open(f"{run_b}/truth.json"))["features"]}
+    fa = {f["id"]: f for f in json.load(open(f"{run_a}/truth.json"))["features"]}
+    tb, ta = as_cut_errors(fb, sizes, depths), as_cut_errors(fa, sizes, depths)
+    ba = {(x["step"], x["quantity"]): x for x in json.load(open(f"{ev_a}/evaluation.json")).get("before_after", [])}
+    for k in range(1, 5):
+        for q in ("width_x", "width_y", "depth"):
+            x = ba.get((k, q))
+            fall = tb[k - 1][q] - ta[k - 1][q]
+            check(f"W1 step {k} {q}: as cut fell {fall:.2f} um, W8's families promised "
+                  f"{x['promised_um'] if x else float('nan'):.2f} +- {x['U_promised_um'] if x else float('nan'):.2f}",
+                  x is not None and abs(fall - x["promised_um"]) <= x["U_promised_um"], x)
+            # The prediction itself: the plain part's error as cut is what W8's families predicted
+            # (so the compensated part lies within U of nominal).
+            check(f"W1 step {k} {q}: predicted {x['promised_um'] if x else float('nan'):.2f} um, the plain part's error as cut "
+                  f"{tb[k - 1][q]:.2f}, the compensated part's {ta[k - 1][q]:.2f}",
+                  x is not None and abs(tb[k - 1][q] - x["promised_um"]) <= x["U_promised_um"]
+                  and abs(ta[k - 1][q]) <= x["U_promised_um"], x)
+    rms_w1 = lambda key: (sum(x[key] ** 2 for x in ba.values()) / max(1, len(ba))) ** 0.5
+    check(f"W1: the CMM's rms error falls from {rms_w1('before_um'):.2f} to {rms_w1('after_um'):.2f} um (by 70 % or more)",
+          len(ba) == 12 and rms_w1("after_um") < 0.3 * rms_w1("before_um"), out)
+
 # --- the HTML report, rendered in Chromium -----------------------------------------------------------
 from html_render import check as render_check  # noqa: E402
 for name, ev_dir, plots in (("one part", ev1, 3), ("compensated part", ev_c, 4)):
