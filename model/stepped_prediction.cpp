@@ -1,6 +1,7 @@
 #include "model/stepped_prediction.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 #include "core/csv.hpp"
 #include "core/error.hpp"
@@ -10,6 +11,13 @@ namespace probeloop::model {
 namespace {
 
 using nlohmann::json;
+
+// Four significant digits (the fitted parameters span 1e-6 to 1e2).
+std::string sig4(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", v);
+  return b;
+}
 
 double num(const json& o, const char* key, const std::string& where, const std::string& file) {
   if (!o.is_object() || !o.contains(key) || !o.at(key).is_number())
@@ -129,9 +137,15 @@ std::string steppedPredictorSummary(const SteppedPredictor& p) {
   std::string s = "Predicted from " + p.file + " (" + p.experiment + ", " + formatNumber(p.speed_ref_rpm) + " rpm): e_pos = k L with k_x " +
                   formatNumber(p.k_um_per_mm[0], 4) + ", k_y " + formatNumber(p.k_um_per_mm[1], 4) + ", k_z " +
                   formatNumber(p.k_um_per_mm[2], 4) + " um/mm\n";
-  for (const auto* c : {&p.proc_x, &p.proc_y, &p.splz})
-    s += "  " + c->name + "(" + c->variable + ") = " + c->fit.function.formula() + " (u " + formatNumber(c->u_pred_um, 3) +
-         " um): " + c->selection.sentence + "\n";
+  for (const auto* c : {&p.proc_x, &p.proc_y, &p.splz}) {
+    const auto& best = c->selection.candidates[static_cast<std::size_t>(c->selection.best)];
+    std::string params;
+    for (std::size_t i = 0; i < c->fit.function.p.size(); ++i)
+      params += (i ? ", " : "") + (i < c->fit.names.size() ? c->fit.names[i] : "p" + std::to_string(i)) + " " + sig4(c->fit.function.p[i]);
+    s += "  " + c->name + "(" + c->variable + "): " + best.candidate.label() + " [" + params + "], the best of " +
+         std::to_string(c->selection.candidates.size()) + " forms by leave-one-out (RMS " + formatNumber(best.loo_rms, 3) +
+         " um over " + std::to_string(c->x.size()) + " points); u " + formatNumber(c->u_pred_um, 3) + " um\n";
+  }
   return s;
 }
 
