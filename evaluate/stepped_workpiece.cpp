@@ -11,6 +11,7 @@
 #include "core/error.hpp"
 #include "evaluate/budget_json.hpp"
 #include "geometry/fit.hpp"
+#include "uncertainty/gum.hpp"
 #include "parts/sw_compensation.hpp"
 
 namespace probeloop::evaluate {
@@ -62,7 +63,8 @@ Contribution contribution(std::string input, char type, std::string dist, std::s
 
 }  // namespace
 
-SwSourceGeometry steppedGeometry(const parts::PlanManifest& m, const TtpPoints& pts, const std::string& route) {
+SwSourceGeometry steppedGeometry(const parts::PlanManifest& m, const TtpPoints& pts, const std::string& route,
+                                 const std::function<double(double)>& point_u_um) {
   SwSourceGeometry g;
   g.file = pts.file;
   g.route = route;
@@ -108,6 +110,32 @@ SwSourceGeometry steppedGeometry(const parts::PlanManifest& m, const TtpPoints& 
     double ss = 0;
     for (const auto& q : it->second) ss += std::pow(p.normal.dot(q - p.point_mm), 2);
     p.rms_um = std::sqrt(ss / std::max(1, p.points - 3)) * 1e3;  // s of the residuals (3 parameters)
+    {
+      int a = 0;
+      nf.direction.cwiseAbs().maxCoeff(&a);
+      const int i = (a + 1) % 3, j = (a + 2) % 3;
+      double mi = 0, mj = 0;
+      for (const auto& q : it->second) mi += q(i), mj += q(j);
+      mi /= p.points;
+      mj /= p.points;
+      Eigen::Matrix2d M = Eigen::Matrix2d::Zero();
+      for (const auto& q : it->second) {
+        const Eigen::Vector2d d(q(i) - mi, q(j) - mj);
+        M += d * d.transpose();
+      }
+      double u_pt = p.rms_um;
+      if (point_u_um) {
+        Vector3d c = Vector3d::Zero();
+        for (const auto& q : it->second) c += q;
+        const double spec = point_u_um((c / p.points).norm());
+        if (spec > u_pt) u_pt = spec, p.slope_u_from_spec = true;
+      }
+      if (std::fabs(M.determinant()) > 1e-12 * std::max(1.0, M.squaredNorm())) {
+        const Eigen::Matrix2d C = M.inverse();
+        p.u_slope[i] = u_pt * 1e-3 * std::sqrt(C(0, 0));
+        p.u_slope[j] = u_pt * 1e-3 * std::sqrt(C(1, 1));
+      }
+    }
     g.planes.push_back(p);
   }
   const SwPlane& top = plane(g, "TOP");
@@ -141,6 +169,22 @@ SwSourceGeometry steppedGeometry(const parts::PlanManifest& m, const TtpPoints& 
     nx.z() = 0;
     ny.z() = 0;
     s.oz_urad = -std::asin(nx.normalized().dot(ny.normalized())) * 1e6;
+    s.u_lean_x_urad = 0.5 * std::hypot(xp.u_slope[2], xn.u_slope[2]) * 1e6;
+    s.u_lean_y_urad = 0.5 * std::hypot(yp.u_slope[2], yn.u_slope[2]) * 1e6;
+    s.u_floor_slope_x_urad = fl.u_slope[0] * 1e6;
+    s.u_floor_slope_y_urad = fl.u_slope[1] * 1e6;
+    s.u_oz_urad = 0.5 * std::hypot(std::hypot(xp.u_slope[1], xn.u_slope[1]), std::hypot(yp.u_slope[0], yn.u_slope[0])) * 1e6;
+    const auto k95 = [](std::initializer_list<const SwPlane*> ps) {
+      int dof = 1 << 20;
+      for (const auto* q : ps)
+        if (!q->slope_u_from_spec) dof = std::min(dof, std::max(1, q->points - 3));
+      return uncertainty::coverageFactor(0.95, dof);
+    };
+    s.U_lean_x_urad = k95({&xp, &xn}) * s.u_lean_x_urad;
+    s.U_lean_y_urad = k95({&yp, &yn}) * s.u_lean_y_urad;
+    s.U_floor_slope_x_urad = k95({&fl}) * s.u_floor_slope_x_urad;
+    s.U_floor_slope_y_urad = k95({&fl}) * s.u_floor_slope_y_urad;
+    s.U_oz_urad = k95({&xp, &xn, &yp, &yn}) * s.u_oz_urad;
     g.steps.push_back(s);
   }
   return g;
@@ -186,9 +230,11 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoi
     throw InputError(m.file, 0, "kind: '" + m.kind + "': the stepped-workpiece evaluation needs a stepped_workpiece plan");
   SwEvaluation e;
   e.experiment = m.sw.experiment;
-  e.cmm = steppedGeometry(m, cmm, "cmm");
-  e.probe = steppedGeometry(m, probe, "on_machine");
   const auto rep = probeRepeatability(m, probe);
+  const double mpe0 = m.sw.cmm.mpe_constant_um, mpeK = m.sw.cmm.mpe_length_mm;
+  e.cmm = steppedGeometry(m, cmm, "cmm", [&](double L) { return (mpe0 + (mpeK > 0 ? L / mpeK : 0.0)) / kSqrt3; });
+  const double s_probe = rep.pairs >= 2 ? rep.s_um : m.probe_repeatability_2sigma_um / 2;
+  e.probe = steppedGeometry(m, probe, "on_machine", [&](double) { return s_probe; });
   e.probe_repeat_pairs = rep.pairs;
   const bool type_a = rep.pairs >= 2;
   const double s_pt = type_a ? rep.s_um : m.probe_repeatability_2sigma_um / 2;
@@ -432,7 +478,12 @@ std::string swEvaluationJson(const SwEvaluation& e) {
                             {"width_x_error_um", t.width_x_error_um()}, {"width_y_error_um", t.width_y_error_um()},
                             {"depth_error_um", t.depth_error_um()}, {"wall_tilt_x_urad", t.lean_x_urad},
                             {"wall_tilt_y_urad", t.lean_y_urad}, {"floor_slope_x_urad", t.floor_slope_x_urad},
-                            {"floor_slope_y_urad", t.floor_slope_y_urad}, {"oz_urad", t.oz_urad}});
+                            {"floor_slope_y_urad", t.floor_slope_y_urad}, {"oz_urad", t.oz_urad},
+                            {"u_wall_tilt_x_urad", t.u_lean_x_urad}, {"u_wall_tilt_y_urad", t.u_lean_y_urad},
+                            {"u_floor_slope_x_urad", t.u_floor_slope_x_urad}, {"u_floor_slope_y_urad", t.u_floor_slope_y_urad},
+                            {"u_oz_urad", t.u_oz_urad}, {"U_wall_tilt_x_urad", t.U_lean_x_urad},
+                            {"U_wall_tilt_y_urad", t.U_lean_y_urad}, {"U_floor_slope_x_urad", t.U_floor_slope_x_urad},
+                            {"U_floor_slope_y_urad", t.U_floor_slope_y_urad}, {"U_oz_urad", t.U_oz_urad}});
     return s;
   };
   j["cmm"] = geom(e.cmm);

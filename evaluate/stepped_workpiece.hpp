@@ -33,6 +33,7 @@
 // than 3 points; GeometryError never escapes as a NaN: a degenerate plane is refused naming it.
 #pragma once
 #include <Eigen/Dense>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,11 @@ struct SwPlane {
   int points = 0;
   Eigen::Vector3d point_mm = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::UnitZ();  // outward
   double rms_um = 0;
+  // Standard uncertainty of the plane's slope d(q_a)/d(q_i) over each other axis i (rad; a =
+  // the axis of the nominal normal): s of the residuals x sqrt of (M^-1)_ii, M the centred
+  // second moments of the points' other two coordinates (type A, n - 3 dof).
+  double u_slope[3] = {0, 0, 0};
+  bool slope_u_from_spec = false;  // the specification was larger than the residual s
 };
 
 struct SwStepGeometry {
@@ -57,6 +63,10 @@ struct SwStepGeometry {
   double lean_x_urad = 0, lean_y_urad = 0;                  // tilt dx/dz (dy/dz) of the X (Y) walls, their mean
   double floor_slope_x_urad = 0, floor_slope_y_urad = 0;    // dz/dx, dz/dy of the floor
   double oz_urad = 0;
+  double u_lean_x_urad = 0, u_lean_y_urad = 0, u_floor_slope_x_urad = 0, u_floor_slope_y_urad = 0, u_oz_urad = 0;
+  // Expanded (95 %): k from Student's t at the fewest degrees of freedom (points - 3) of the
+  // planes involved (a wall of 6 points has 3: k = 3.18), JCGM 100 G.3.
+  double U_lean_x_urad = 0, U_lean_y_urad = 0, U_floor_slope_x_urad = 0, U_floor_slope_y_urad = 0, U_oz_urad = 0;
   double width_x_error_um() const { return (width_x_mm - size_mm) * 1e3; }
   double width_y_error_um() const { return (width_y_mm - size_mm) * 1e3; }
   double depth_error_um() const { return (depth_mm - depth_nominal_mm) * 1e3; }
@@ -103,7 +113,12 @@ struct SwEvaluation {
   std::vector<SwBeforeAfter> before_after;
 };
 
-SwSourceGeometry steppedGeometry(const parts::PlanManifest& m, const TtpPoints& points, const std::string& route);
+// point_u_um(L): the route's specified standard uncertainty of one point at distance L (mm) from
+// the part origin (CMM: MPE(L) / sqrt 3; probe: its repeatability); a plane's slope u uses the
+// larger of it and the plane's residual s (the specification: infinite dof, k = 2; the residual:
+// n - 3 dof). Absent: the residual alone.
+SwSourceGeometry steppedGeometry(const parts::PlanManifest& m, const TtpPoints& points, const std::string& route,
+                                 const std::function<double(double)>& point_u_um = {});
 
 // The manifest's repeated probe points (same feature, same nominal contact): s of one point.
 struct SwRepeatability {

@@ -226,7 +226,11 @@ std::string steppedWorkpieceReportHtml(const json& eval, const std::string& file
   for (const char* route : {"cmm", "on_machine"})
     for (const auto& st : array(object(eval, route), "steps")) {
       auto f2 = [&](const char* k) { const auto v = number(st, k); return v ? fixed(*v, 2) : kDash; };
-      auto f1 = [&](const char* k) { const auto v = number(st, k); return v ? fixed(*v, 1) : kDash; };
+      auto f1 = [&](const char* k) {
+        const auto v = number(st, k);
+        const auto U = number(st, ("U_" + std::string(k)).c_str());
+        return v ? fixed(*v, 1) + (U ? " \u00b1 " + fixed(*U, 1) : std::string()) : kDash;
+      };
       page.html += "<tr>" + td(route) + td(whole(number(st, "step"))) + td(f2("width_x_error_um"), true) +
                    td(f2("width_y_error_um"), true) + td(f2("depth_error_um"), true) + td(f1("wall_tilt_x_urad"), true) +
                    td(f1("wall_tilt_y_urad"), true) + td(f1("floor_slope_x_urad"), true) + td(f1("floor_slope_y_urad"), true) +

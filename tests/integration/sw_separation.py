@@ -115,6 +115,28 @@ def truth_recovery(label, run_dir, ev_dir):
         near(f"step {k} e_pos_z", s["e_pos_z_um"], mean_axis("TOP", 2) - mean_axis(f"S{k}_F", 2))
         t = feats[f"S{k}_F"]["machine"]["tool_um"][2] - feats["TOP"]["machine"]["tool_um"][2]
         near(f"step {k} e_splz (T {s['temp_state_min']:.0f} min)", s["e_splz_um"], t, resolved=k >= 2)
+    # The CMM route's orientations against the surfaces as cut (truth.json normals): the walls'
+    # tilt, the floors' slopes (the table tilt the straightness EZX/EZY makes) and Oz. Planes of
+    # 6-9 points: a coverage test, not 20 separate ones: at least 90 % within their U (95 %
+    # expected), none beyond 2 U, and Oz and the floors' X slope of steps 3-4 resolved.
+    def sl(fid, over, along):
+        n = feats[fid]["as_cut"]["normal"]
+        return -n[over] / n[along] * 1e6
+
+    orient = []
+    for g in ev["cmm"]["steps"]:
+        k = g["step"]
+        truth_o = {"wall_tilt_x": (sl(f"S{k}_XP", 2, 0) + sl(f"S{k}_XN", 2, 0)) / 2,
+                   "wall_tilt_y": (sl(f"S{k}_YP", 2, 1) + sl(f"S{k}_YN", 2, 1)) / 2,
+                   "floor_slope_x": sl(f"S{k}_F", 0, 2), "floor_slope_y": sl(f"S{k}_F", 1, 2),
+                   "oz": (sl(f"S{k}_XP", 1, 0) + sl(f"S{k}_XN", 1, 0)) / 2 + (sl(f"S{k}_YP", 0, 1) + sl(f"S{k}_YN", 0, 1)) / 2}
+        for q, t in truth_o.items():
+            v, U = g[f"{q}_urad"], g[f"U_{q}_urad"]
+            orient.append((f"step {k} {q} {v:.1f} +- {U:.1f} urad (as cut {t:.1f})", v, U, t, k >= 3 and q in ("oz", "floor_slope_x")))
+    within = sum(1 for _, v, U, t, _ in orient if abs(v - t) <= U)
+    check(f"{label}: orientations (CMM) within U: {within} of {len(orient)}; none beyond 2 U; Oz and floor X slope of steps 3-4 resolved",
+          orient and within >= 0.9 * len(orient) and all(U > 0 and abs(v - t) <= 2 * U for _, v, U, t, _ in orient)
+          and all(abs(t) > U for _, v, U, t, r in orient if r), [o[0] for o in orient if abs(o[1] - o[3]) > o[2]])
     rows = list(csv.DictReader(line for line in open(f"{ev_dir}/errors.csv") if not line.startswith("#")))
     check(f"{label}: errors.csv has a row per step with U", len(rows) == 4 and all(float(r["U_e_splz_um"]) > 0 for r in rows), rows)
     return ev, feats
