@@ -75,6 +75,7 @@ parts::SwCompensation predictedCompensation(const planner::TestPiecePlan& first,
     x.U_floor_um = p.U_depth_um;
     c.steps.push_back(x);
   }
+  parts::validateSwCompensation(c);
   return c;
 }
 

@@ -230,6 +230,7 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoi
     throw InputError(m.file, 0, "kind: '" + m.kind + "': the stepped-workpiece evaluation needs a stepped_workpiece plan");
   SwEvaluation e;
   e.experiment = m.sw.experiment;
+  e.applied = m.sw.compensation;
   const auto rep = probeRepeatability(m, probe);
   const double mpe0 = m.sw.cmm.mpe_constant_um, mpeK = m.sw.cmm.mpe_length_mm;
   e.cmm = steppedGeometry(m, cmm, "cmm", [&](double L) { return (mpe0 + (mpeK > 0 ? L / mpeK : 0.0)) / kSqrt3; });
@@ -414,10 +415,27 @@ void compareWithBefore(SwEvaluation& e, const parts::PlanManifest& m, const std:
   const auto& bs = b.at("cmm").at("steps");
   if (bs.size() != e.cmm.steps.size() || m.sw.compensation.size() != e.cmm.steps.size())
     throw InputError(file, 0, "cmm.steps: " + std::to_string(bs.size()) + " steps, this part has " + std::to_string(e.cmm.steps.size()));
+  // The offsets the earlier part was cut with (0 when it was not compensated).
+  std::vector<parts::SwStepCompensation> before_applied(bs.size());
+  if (b.contains("compensation_applied") && b.at("compensation_applied").is_array()) {
+    const auto& ba = b.at("compensation_applied");
+    if (ba.size() != bs.size()) throw InputError(file, 0, "compensation_applied: one entry per step expected");
+    try {
+      for (std::size_t i = 0; i < ba.size(); ++i) {
+        for (int w = 0; w < 4; ++w)
+          before_applied[i].wall_um[static_cast<std::size_t>(w)] = ba[i].at("wall_um").at(parts::kSwWalls[w]).get<double>();
+        before_applied[i].floor_um = ba[i].at("floor_um").get<double>();
+      }
+    } catch (const nlohmann::json::exception& x) {
+      throw InputError(file, 0, std::string("compensation_applied: expected wall_um {XP, XN, YP, YN} and floor_um per step (") + x.what() + ")");
+    }
+  }
   e.compared_with = file;
   for (std::size_t i = 0; i < bs.size(); ++i) {
     const auto& after = e.cmm.steps[i];
-    const auto& c = m.sw.compensation[i];
+    parts::SwStepCompensation c = m.sw.compensation[i];
+    for (int w = 0; w < 4; ++w) c.wall_um[static_cast<std::size_t>(w)] -= before_applied[i].wall_um[static_cast<std::size_t>(w)];
+    c.floor_um -= before_applied[i].floor_um;
     const struct {
       const char* q;
       double after, promised, U;
@@ -503,6 +521,14 @@ std::string swEvaluationJson(const SwEvaluation& e) {
                                {"predicted_width_x_um", budgetJson(s.predicted_width_x_um)},
                                {"predicted_width_y_um", budgetJson(s.predicted_width_y_um)},
                                {"predicted_depth_um", budgetJson(s.predicted_depth_um)}});
+  if (!e.applied.empty()) {
+    j["compensation_applied"] = nlohmann::ordered_json::array();
+    for (const auto& c : e.applied) {
+      nlohmann::ordered_json w;
+      for (int i = 0; i < 4; ++i) w[parts::kSwWalls[i]] = c.wall_um[static_cast<std::size_t>(i)];
+      j["compensation_applied"].push_back({{"step", c.step}, {"wall_um", w}, {"floor_um", c.floor_um}});
+    }
+  }
   if (!e.compared_with.empty()) {
     j["compared_with"] = e.compared_with;
     for (const auto& x : e.before_after)

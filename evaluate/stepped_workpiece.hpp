@@ -111,6 +111,9 @@ struct SwEvaluation {
   std::vector<std::string> notes;
   std::string compared_with;
   std::vector<SwBeforeAfter> before_after;
+  // The offsets the plan applied (its manifest's compensation; empty: none), written to
+  // evaluation.json so that a later --compare promises only the change between the two plans.
+  std::vector<parts::SwStepCompensation> applied;
 };
 
 // point_u_um(L): the route's specified standard uncertainty of one point at distance L (mm) from
@@ -131,7 +134,8 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoi
 
 // Fills before_after from the earlier evaluation.json (InputError naming the file when it is
 // not a stepped-workpiece evaluation of the same experiment and steps) and the manifest's
-// compensation (InputError when the plan was not compensated).
+// compensation (InputError when the plan was not compensated). When the earlier part was itself
+// compensated (its "compensation_applied"), the promised fall is the change of the offsets.
 void compareWithBefore(SwEvaluation& e, const parts::PlanManifest& m, const std::string& before_json_file);
 
 // Outputs: errors.csv (one row per step: the components with u and U), evaluation.json,

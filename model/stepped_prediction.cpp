@@ -5,6 +5,7 @@
 
 #include "core/csv.hpp"
 #include "core/error.hpp"
+#include "uncertainty/gum.hpp"
 
 namespace probeloop::model {
 
@@ -52,6 +53,7 @@ SteppedComponent component(std::string name, std::string variable, std::vector<d
     if (v > 0) su += v * v, ++n;
   const double rms_u = n ? std::sqrt(su / n) : 0.0;
   c.u_pred_um = std::hypot(rms_u, best.loo_rms);
+  c.k95 = uncertainty::coverageFactor(0.95, std::max(1, best.fit.n - best.fit.parameters));
   for (double v : c.x) c.x_max = std::max(c.x_max, v);
   return c;
 }
@@ -103,6 +105,7 @@ SteppedPredictor steppedPredictorFromEvaluation(const json& e, const std::string
   const auto& cs = e.contains("cmm") ? e.at("cmm").value("steps", json::array()) : json::array();
   if (cs.empty()) throw InputError(file, 0, "cmm.steps: missing (the sizes of the steps)");
   p.tool_d_mm = num(seps[0], "travel_tool_mm", "separation[0].", file) - num(cs[0], "size_mm", "cmm.steps[0].", file);
+  p.probe_d_mm = num(seps[0], "travel_probe_mm", "separation[0].", file) - num(cs[0], "size_mm", "cmm.steps[0].", file);
   p.speed_ref_rpm = speed;
   const std::vector<Candidate> feed_forms{{Family::Polynomial, 1, true}, {Family::Polynomial, 2, true}, {Family::Hyperbolic, 0, false}};
   const std::vector<Candidate> time_forms{{Family::SaturatingExponential, 0, false},
@@ -125,9 +128,10 @@ std::vector<SteppedPrediction> predictSteppedErrors(const SteppedPredictor& p, c
     r.width_x_um = p.k_um_per_mm[0] * L + p.proc_x.at(c.feed_mm_per_min);
     r.width_y_um = p.k_um_per_mm[1] * L + p.proc_y.at(c.feed_mm_per_min);
     r.depth_um = p.k_um_per_mm[2] * c.depth_mm - scale * p.splz.at(c.temp_state_min);
-    r.U_width_x_um = 2 * std::hypot(p.u_k_um_per_mm[0] * L, p.proc_x.u_pred_um);
-    r.U_width_y_um = 2 * std::hypot(p.u_k_um_per_mm[1] * L, p.proc_y.u_pred_um);
-    r.U_depth_um = 2 * std::hypot(p.u_k_um_per_mm[2] * c.depth_mm, scale * p.splz.u_pred_um);
+    const double Lp = c.size_mm + p.probe_d_mm;
+    r.U_width_x_um = std::hypot(2 * p.u_k_um_per_mm[0] * Lp, p.proc_x.k95 * p.proc_x.u_pred_um);
+    r.U_width_y_um = std::hypot(2 * p.u_k_um_per_mm[1] * Lp, p.proc_y.k95 * p.proc_y.u_pred_um);
+    r.U_depth_um = std::hypot(2 * p.u_k_um_per_mm[2] * c.depth_mm, scale * p.splz.k95 * p.splz.u_pred_um);
     out.push_back(r);
   }
   return out;

@@ -13,7 +13,9 @@
 //   width error = e_pos(size + tool d) + e_proc(F)  (+ e_pt: 0 from one part),
 //   depth error = k_z depth - e_splz(T).
 // u of a predicted component: sqrt(rms(u_i)^2 + loo^2), the measured points' own u and the
-// family's leave-one-out RMS (its error out of sample); u(k) x the travel for e_pos.
+// family's leave-one-out RMS (its error out of sample), expanded with Student's t at (points -
+// parameters) dof; e_pos adds u(k) x (size + stylus d), its sensitivity to k once e_proc was
+// separated with the same k (e_proc's points already carry u(k) x (tool d - stylus d)).
 //
 // Contract: GeometryError / InputError (naming the file) for an evaluation without the fields
 // above, fewer than 3 steps, no family that fits; the prediction refuses a feed or a Temp state
@@ -34,13 +36,14 @@ struct SteppedComponent {
   Selection selection;
   FamilyFit fit;              // the chosen family's fit
   double u_pred_um = 0;       // sqrt(rms(u)^2 + loo^2)
+  double k95 = 2;             // Student's t (95 %) at points - parameters dof
   double x_max = 0;
   double at(double x) const;  // GeometryError beyond 2 x_max
 };
 
 struct SteppedPredictor {
   std::string file, experiment;
-  double speed_ref_rpm = 0, tool_d_mm = 0;
+  double speed_ref_rpm = 0, tool_d_mm = 0, probe_d_mm = 0;
   double k_um_per_mm[3] = {0, 0, 0}, u_k_um_per_mm[3] = {0, 0, 0};  // x, y, z
   SteppedComponent proc_x, proc_y, splz;
 };

@@ -57,13 +57,26 @@ SwCompensation loadSwCompensation(const std::string& path) {
     }
     x.floor_um = number(s, "floor_um", where, path);
     x.U_floor_um = number(s, "U_floor_um", where, path, false);
-    for (double v : {x.wall_um[0], x.wall_um[1], x.wall_um[2], x.wall_um[3], x.floor_um})
-      if (std::fabs(v) > kMaxOffsetUm)
-        throw InputError(path, 0, where + ": offset " + formatNumber(v) + " um beyond +-" + formatNumber(kMaxOffsetUm) +
-                                      " um: a compensation corrects micrometres, not the design");
     c.steps.push_back(x);
   }
+  validateSwCompensation(c);
   return c;
+}
+
+void validateSwCompensation(const SwCompensation& c) {
+  for (std::size_t i = 0; i < c.steps.size(); ++i) {
+    const auto& x = c.steps[i];
+    const std::string where = "steps[" + std::to_string(i) + "]";
+    if (x.step != static_cast<int>(i) + 1)
+      throw InputError(c.file, 0, where + ".step: expected " + std::to_string(i + 1) + " (in order from the top)");
+    for (double v : {x.wall_um[0], x.wall_um[1], x.wall_um[2], x.wall_um[3], x.floor_um, x.U_wall_um[0], x.U_wall_um[1],
+                     x.U_wall_um[2], x.U_wall_um[3], x.U_floor_um})
+      if (!std::isfinite(v)) throw InputError(c.file, 0, where + ": an offset or its U is not finite");
+    for (double v : {x.wall_um[0], x.wall_um[1], x.wall_um[2], x.wall_um[3], x.floor_um})
+      if (std::fabs(v) > kMaxOffsetUm)
+        throw InputError(c.file, 0, where + ": offset " + formatNumber(v) + " um beyond +-" + formatNumber(kMaxOffsetUm) +
+                                        " um: a compensation corrects micrometres, not the design");
+  }
 }
 
 std::string swCompensationJson(const SwCompensation& c) {

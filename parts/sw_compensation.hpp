@@ -36,6 +36,9 @@ struct SwCompensation {
 inline constexpr const char* kSwWalls[4] = {"XP", "XN", "YP", "YN"};
 
 SwCompensation loadSwCompensation(const std::string& path);
+// The checks the loader makes, for a compensation built in memory (a prediction): finite
+// offsets within +-500 um, steps in order; InputError naming c.file and the key.
+void validateSwCompensation(const SwCompensation& c);
 std::string swCompensationJson(const SwCompensation& c);
 
 }  // namespace probeloop::parts

@@ -47,13 +47,18 @@ struct Material {
     std::vector<Box> out;
     const std::size_t n = half.size();
     const auto shift = [](const std::vector<double>& v, std::size_t j) { return j < v.size() ? v[j] : 0.0; };
+    // Box j's top: the floor of step j - 1 (0: the top face), where its compensated pass cut it
+    // once finished, the margin above the nominal floor before; its bottom: its own floor,
+    // reaching down to a floor the compensation lowered.
     for (std::size_t j = 0; j < n; ++j) {
-      const double top = j == 0 ? 0.0 : -w.steps[j - 1].floor_depth_mm + shift(floor_up, j - 1);
+      const bool top_done = static_cast<int>(j) < tops_finished;
+      const double top = j == 0 ? 0.0 : -w.steps[j - 1].floor_depth_mm + (top_done ? shift(floor_up, j - 1) : 0.0);
       const double h = half[j] + (static_cast<int>(j) < walls_finished ? shift(wall_out, j) : m);
-      const double z_hi = top + (static_cast<int>(j) < tops_finished ? 0.0 : m);
-      out.push_back({h, h, -w.steps[j].floor_depth_mm, z_hi});
+      const double z_hi = top + (top_done ? 0.0 : m);
+      out.push_back({h, h, -w.steps[j].floor_depth_mm + std::min(shift(floor_up, j), 0.0), z_hi});
     }
-    const double base_top = -w.steps.back().floor_depth_mm + shift(floor_up, n - 1) + (static_cast<int>(n) < tops_finished ? 0.0 : m);
+    const bool base_done = static_cast<int>(n) < tops_finished;
+    const double base_top = -w.steps.back().floor_depth_mm + (base_done ? shift(floor_up, n - 1) : m);
     out.push_back({bx, by, c_bottom, base_top});
     // The fixture under the blank (a box round its circle: the safe side).
     out.push_back({w.fixture_diameter_mm / 2, w.fixture_diameter_mm / 2, c_bottom - w.fixture_height_mm, c_bottom});
@@ -90,6 +95,21 @@ class Builder {
     if (comp_ && comp_->steps.size() != e_->steps.size())
       throw InputError(comp_->file, 0, "steps: " + std::to_string(comp_->steps.size()) + " given, experiment " + e_->id + " has " +
                                            std::to_string(e_->steps.size()));
+    // Roughing leaves the finishing margin: a wall moved out or a floor raised by more would be
+    // cut in the air and stay where roughing left it.
+    if (comp_)
+      for (std::size_t k = 0; k < comp_->steps.size(); ++k) {
+        const auto& c = comp_->steps[k];
+        const double mrg_um = w.finishing_margin_mm * 1e3;
+        for (int i = 0; i < 4; ++i)
+          if (c.wall_um[static_cast<std::size_t>(i)] < -mrg_um)
+            throw InputError(comp_->file, 0, "steps[" + std::to_string(k) + "].wall_um." + parts::kSwWalls[i] + ": " +
+                                                 formatNumber(c.wall_um[static_cast<std::size_t>(i)]) + " um moves the wall out by more "
+                                                 "than the finishing margin (" + formatNumber(mrg_um) + " um) roughing leaves");
+        if (c.floor_um > mrg_um)
+          throw InputError(comp_->file, 0, "steps[" + std::to_string(k) + "].floor_um: " + formatNumber(c.floor_um) +
+                                               " um raises the floor by more than the finishing margin (" + formatNumber(mrg_um) + " um)");
+      }
     sizes_ = w.sizesFor(*e_);
     for (double s : sizes_) material_.half.push_back(s / 2);
     features_ = parts::nominalFeatures(w, sizes_);
@@ -654,7 +674,12 @@ class Builder {
     s.tool_runout_mm = e_->tool_runout_mm;
     s.tool_diameter_mm = tool_->diameter_mm;
     if (comp_) {
+      // As the programs apply them: rounded to 0.1 um.
       s.compensation = comp_->steps;
+      for (auto& c : s.compensation) {
+        for (auto& v : c.wall_um) v = toProgram(v) * 1e3;
+        c.floor_um = toProgram(c.floor_um) * 1e3;
+      }
       s.compensation_file = comp_->file;
     }
     s.sizes_mm = sizes_;

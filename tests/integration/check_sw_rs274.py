@@ -272,7 +272,7 @@ def comp_mm(step, key):
         return 0.0
     s = COMP["steps"][step - 1]
     um = s["floor_um"] if key == "floor_um" else s["wall_um"][key]
-    return round(um * 10) / 1e4
+    return math.copysign(math.floor(abs(um) * 10 + 0.5), um) / 1e4  # half away from zero, as the planner
 roles = [p.get("role") for p in plan["programs"]]
 if roles != ["roughing", "finishing", "probing"]:
     sys.exit(f"check_sw_rs274.py: the manifest's programs are {roles}, expected roughing, finishing, probing")

@@ -221,5 +221,15 @@ refuses("no --experiment: refused, the message lists W1 ... W8", PIECE, [f"W{k}"
 refuses("--experiment W9: refused, naming W9 and the experiments there are", PIECE,
         ["W9"] + [f"W{k}" for k in range(1, 9)], "--experiment", "W9")
 
+# A compensation that moves a floor up by more than the finishing margin roughing leaves.
+thin = variant("finishing_margin: 0.5 mm", "finishing_margin: 0.2 mm")
+raised = dict(COMP, experiment="W8", steps=[dict(st, wall_um={"XP": 0, "XN": 0, "YP": 0, "YN": 0}, floor_um=(300.0 if st["step"] == 2 else 0.0))
+                                              for st in COMP["steps"]])
+open(f"{W}/raised.json", "w").write(json.dumps(raised))
+refuses("a floor raised beyond the finishing margin is refused (the key and the value)", thin,
+        ["raised.json", "steps[1].floor_um: 300 um raises the floor by more than the finishing margin (200 um)"],
+        "--experiment", "W8", "--compensate", f"{W}/raised.json")
+
+
 shutil.rmtree(W, ignore_errors=True) if check.failed == 0 else print(f"     (outputs kept in {W})")
 check.finish()

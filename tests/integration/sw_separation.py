@@ -234,6 +234,30 @@ for k in range(1, 5):
               f"the compensated part's {ta[k - 1][q]:.2f}",
               abs(tb[k - 1][q] - x["promised_um"]) <= x["U_promised_um"] and abs(ta[k - 1][q]) <= x["U_promised_um"], x)
 rms = lambda key: (sum(x[key] ** 2 for x in ba.values()) / len(ba)) ** 0.5
+# --- a second iteration: the compensated part's compensation.json holds the whole offset from
+# nominal; against the compensated part, the new plan promises only the change of the offsets --
+if not QUICK:
+    plan_c2 = f"{W}/plan-compensated-2"
+    code, out, err = run("plan", PIECE, "--machine", VMC, "--out", plan_c2, "--experiment", "W8", "--compensate",
+                         f"{ev_c}/compensation.json")
+    check("plan W8 --compensate with the compensated part's compensation.json", code == 0, err)
+    if code == 0:
+        run_c2, ev_c2, out = simulate_and_evaluate("compensated twice", plan_c2, "4", compare=f"{ev_c}/evaluation.json")
+        c1 = json.load(open(f"{plan_c}/plan.json"))["stepped_workpiece"]["compensation"]["steps"]
+        c2 = json.load(open(f"{plan_c2}/plan.json"))["stepped_workpiece"]["compensation"]["steps"]
+        rows2 = {(x["step"], x["quantity"]): x for x in json.load(open(f"{ev_c2}/evaluation.json")).get("before_after", [])}
+        worst = 0.0
+        for k in range(1, 5):
+            a, b = c1[k - 1], c2[k - 1]
+            change = {"width_x": b["wall_um"]["XP"] + b["wall_um"]["XN"] - a["wall_um"]["XP"] - a["wall_um"]["XN"],
+                      "width_y": b["wall_um"]["YP"] + b["wall_um"]["YN"] - a["wall_um"]["YP"] - a["wall_um"]["YN"],
+                      "depth": b["floor_um"] - a["floor_um"]}
+            for q, v in change.items():
+                worst = max(worst, abs(rows2[(k, q)]["promised_um"] - v) if (k, q) in rows2 else 1e9)
+        total = max(abs(b["floor_um"]) for b in c2)
+        check(f"second iteration: the promised falls are the changes of the offsets (worst {worst:.2g} um), "
+              f"the offsets themselves stay whole (floor up to {total:.1f} um)", len(rows2) == 12 and worst < 1e-9 and total > 5, rows2)
+
 # --- prediction for another experiment (Ch. 6): W1 (feed 100 throughout, other Temp states) from
 # the families fitted to W8's components; W1 cut plain and compensated, the fall per feature ------
 plan_w1, plan_w1c = f"{W}/plan-w1", f"{W}/plan-w1-predicted"
