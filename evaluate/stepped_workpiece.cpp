@@ -268,8 +268,9 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoi
       const int n1 = a == 0 ? count(e.probe, stepId(k, "XP")) : a == 1 ? count(e.probe, stepId(k, "YP")) : count(e.probe, "TOP");
       const int n2 = a == 0 ? count(e.probe, stepId(k, "XN")) : a == 1 ? count(e.probe, stepId(k, "YN")) : count(e.probe, stepId(k, "F"));
       const double u_fit_cmm = a == 0 ? c.u_wall_x_um : a == 1 ? c.u_wall_y_um : c.u_depth_um;
+      const double u_rep = s_pt * std::sqrt(1.0 / n1 + 1.0 / n2);
       std::vector<Contribution> cs{
-          contribution("probe repeatability", type_a ? 'A' : 'B', "normal", rep_basis, s_pt * std::sqrt(1.0 / n1 + 1.0 / n2), dof_pt),
+          contribution("probe repeatability", type_a ? 'A' : 'B', "normal", rep_basis, u_rep, dof_pt),
           contribution("CMM length measurement", 'B', "rectangular", "MPE " + formatNumber(mpe(L), 3) + " um at " + formatNumber(L) + " mm",
                        mpe(L) / kSqrt3),
           contribution("CMM plane fits", 'A', "normal", "s of the residuals / sqrt(n) of both planes", u_fit_cmm,
@@ -279,7 +280,8 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoi
           contribution("part temperature on the machine", 'B', "rectangular",
                        "20 C +- " + formatNumber(kMachinePartHalfWidthK) + " K (not measured)", alpha * L * kMachinePartHalfWidthK / kSqrt3)};
       b[a] = uncertainty::combine(std::string("e_pos_") + axes[a] + "_um", "um", value, cs);
-      own[a] = std::sqrt(std::pow(cs[0].u, 2) + std::pow(cs[2].u, 2) + std::pow(m.sw.cmm.mpe_constant_um / kSqrt3, 2));
+      // The step's own part of u_c: repeatability, the CMM's planes and the MPE's constant.
+      own[a] = std::sqrt(u_rep * u_rep + u_fit_cmm * u_fit_cmm + std::pow(m.sw.cmm.mpe_constant_um / kSqrt3, 2));
     }
     pos.push_back(b);
     u_own.push_back(own);

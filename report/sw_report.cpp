@@ -257,7 +257,8 @@ std::string steppedWorkpieceReportHtml(const json& eval, const std::string& file
     for (const char* key : {"e_pos_x_um", "e_pos_y_um", "e_pos_z_um", "e_proc_x_um", "e_proc_y_um", "e_splz_um"}) {
       const auto& b = object(last, key);
       const auto& cs = array(b, "contributions");
-      const json& c0 = cs.empty() ? object(b, "none") : cs.front();
+      static const json kNone = json::object();
+      const json& c0 = cs.empty() ? kNone : cs.front();
       page.html += "<tr>" + td(key) + td(sig(number(b, "U"), 3), true) + td(text(c0, "input")) + td(sig(number(c0, "u"), 3), true) +
                    td(text(c0, "basis")) + "</tr>\n";
     }
