@@ -10,6 +10,9 @@
 
 #include "cli/model_commands.hpp"
 #include "cli/report_commands.hpp"
+#include "cli/json_file.hpp"
+#include "cli/separate_command.hpp"
+#include "model/thermal_stages.hpp"
 #include "core/atomic_file.hpp"
 #include "core/csv.hpp"
 #include "core/error.hpp"
@@ -48,13 +51,18 @@ parts::SwCompensation predictedCompensation(const planner::TestPiecePlan& first,
   const auto& m = first.manifest;
   if (m.kind != "stepped_workpiece")
     throw InputError(evaluation_file, 0, "--predict-from: only a stepped workpiece's finishing takes a predicted compensation");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(readFile(evaluation_file));
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(evaluation_file, 0, std::string("not JSON: ") + e.what());
+  const nlohmann::json j = cli::readJsonFile(evaluation_file);
+  // A campaign's separation.json (`probeloop separate`): its process part with the thermal
+  // stages; else one part's evaluation.json.
+  model::SteppedPredictor predictor;
+  if (j.is_object() && j.value("kind", "") == "stepped_separation") {
+    const auto c = model::campaignFromSeparationJson(j, evaluation_file);
+    if (c.process_evaluation.is_null())
+      throw InputError(evaluation_file, 0, "process_evaluation: missing (run `probeloop separate` with --process: the part cut at changing feeds)");
+    predictor = model::steppedPredictorFromCampaign(c.stages, c.process_evaluation, c.process_file);
+  } else {
+    predictor = model::steppedPredictorFromEvaluation(j, evaluation_file);
   }
-  const auto predictor = model::steppedPredictorFromEvaluation(j, evaluation_file);
   std::vector<model::SteppedConditions> conds;
   for (std::size_t i = 0; i < m.sw.steps.size() && i < m.sw.sizes_mm.size(); ++i) {
     const auto& s = m.sw.steps[i];
@@ -413,11 +421,14 @@ int main(int argc, char** argv) {
   const auto run_model = cli::addModelCommands(app, model_group);
   CLI::App* report_group = nullptr;
   const auto run_report = cli::addReportCommands(app, report_group);
+  CLI::App* separate_cmd = nullptr;
+  const auto run_separate = cli::addSeparateCommand(app, separate_cmd);
 
   CLI11_PARSE(app, argc, argv);
   try {
     if (*model_group) return run_model();
     if (*report_group) return run_report();
+    if (*separate_cmd) return run_separate();
     if (*plan) return cmdPlan(artifact, machine, out, dialect, experiment, compensate, predict_from);
     if (*res) return cmdResolution(artifact, machine, step_um);
     if (*syn) return cmdSynth(manifest, truth, out, seed);

@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "cli/json_file.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "parts/plan_manifest.hpp"
@@ -21,14 +22,6 @@ struct TtpArgs {
   report::TtpReportOptions options;
 };
 
-nlohmann::json readJson(const std::string& path) {
-  const std::string text = readFile(path);
-  try {
-    return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path, 0, std::string("not valid JSON (") + e.what() + ")");
-  }
-}
 
 // The report and scene name no file in the errors they cannot place (the scene's evaluation).
 template <class F>
@@ -44,9 +37,9 @@ auto naming(const std::string& file, F&& f) {
 int runTtp(TtpArgs a) {
   if (a.html.empty() && a.scene.empty())
     throw InputError("", 0, "report ttp: nothing to write; give --html and/or --scene");
-  const nlohmann::json evaluation = readJson(a.evaluation);
+  const nlohmann::json evaluation = readJsonFile(a.evaluation);
   std::optional<nlohmann::json> second;
-  if (!a.second.empty()) second = readJson(a.second);
+  if (!a.second.empty()) second = readJsonFile(a.second);
   std::optional<std::string> r_test;
   if (!a.r_test.empty()) r_test = readFile(a.r_test);
   a.options.evaluation_file = a.evaluation;
@@ -81,7 +74,7 @@ struct SwArgs {
 };
 
 int runStepped(const SwArgs& a) {
-  const nlohmann::json evaluation = readJson(a.evaluation);
+  const nlohmann::json evaluation = readJsonFile(a.evaluation);
   const std::string html = report::steppedWorkpieceReportHtml(evaluation, a.evaluation);
   writeFileAtomic(a.html, html);
   std::printf("Wrote %s (stepped-workpiece report: %s)\n", a.html.c_str(), a.evaluation.c_str());

@@ -13,14 +13,15 @@
 //   width error = e_pos(size + tool d) + e_proc(F)  (+ e_pt: 0 from one part),
 //   depth error = k_z depth - e_splz(T).
 // u of a predicted component: sqrt(rms(u_i)^2 + loo^2), the measured points' own u and the
-// family's leave-one-out RMS (its error out of sample), expanded with Student's t at (points -
-// parameters) dof; e_pos adds u(k) x (size + stylus d), its sensitivity to k once e_proc was
+// family's leave-one-out RMS (its error out of sample), expanded with Student's t at the
+// Welch-Satterthwaite dof (the points' u many, the leave-one-out RMS points - parameters); e_pos adds u(k) x (size + stylus d), its sensitivity to k once e_proc was
 // separated with the same k (e_proc's points already carry u(k) x (tool d - stylus d)).
 //
 // Contract: GeometryError / InputError (naming the file) for an evaluation without the fields
 // above, fewer than 3 steps, no family that fits; the prediction refuses a feed or a Temp state
 // beyond twice the largest measured one (an extrapolation the part cannot support).
 #pragma once
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -36,9 +37,15 @@ struct SteppedComponent {
   Selection selection;
   FamilyFit fit;              // the chosen family's fit
   double u_pred_um = 0;       // sqrt(rms(u)^2 + loo^2)
-  double k95 = 2;             // Student's t (95 %) at points - parameters dof
+  double k95 = 2;             // Student's t (95 %) at the effective dof (see above)
   double x_max = 0;
   double at(double x) const;  // GeometryError beyond 2 x_max
+};
+
+// A campaign's thermal terms at (Temp state, spindle speed) (model/thermal_stages.hpp), U at k95.
+struct ThermalTerms {
+  double pt_x_um = 0, pt_y_um = 0, splz_um = 0, U_pt_x_um = 0, U_pt_y_um = 0, U_splz_um = 0;
+  std::string basis;
 };
 
 struct SteppedPredictor {
@@ -46,7 +53,15 @@ struct SteppedPredictor {
   double speed_ref_rpm = 0, tool_d_mm = 0, probe_d_mm = 0;
   double k_um_per_mm[3] = {0, 0, 0}, u_k_um_per_mm[3] = {0, 0, 0};  // x, y, z
   SteppedComponent proc_x, proc_y, splz;
+  // From a campaign: the thermal terms; absent (one part): e_pt 0, e_splz scaled by S / S_ref.
+  std::function<ThermalTerms(double temp_state_min, double spindle_rpm)> thermal;
+  std::string thermal_summary;
 };
+
+// One component fitted: the best of `candidates` by leave-one-out, u_pred and k95 as above;
+// GeometryError naming the file and the component when no candidate fits.
+SteppedComponent fitSteppedComponent(std::string name, std::string variable, std::vector<double> x, std::vector<double> y,
+                                     std::vector<double> u, const std::vector<Candidate>& candidates, const std::string& file);
 
 SteppedPredictor steppedPredictorFromEvaluation(const nlohmann::json& evaluation, const std::string& file);
 
@@ -63,6 +78,8 @@ struct SteppedPrediction {
 
 std::vector<SteppedPrediction> predictSteppedErrors(const SteppedPredictor& p, const std::vector<SteppedConditions>& steps);
 
+// One component's line: its family, parameters (4 significant digits), leave-one-out RMS and u.
+std::string steppedComponentSummary(const SteppedComponent& c);
 // The sentence a report or plan prints: which family each component follows and why.
 std::string steppedPredictorSummary(const SteppedPredictor& p);
 

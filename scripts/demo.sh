@@ -137,7 +137,22 @@ $PL simulate "$S/plan-compensated/roughing.ngc" "$S/plan-compensated/finishing.n
 $PL evaluate "$S/run-compensated/cmm_export.csv" --probe-log "$S/run-compensated/sw_probe.log" \
   --manifest "$S/plan-compensated/plan.json" --compare "$S/eval/evaluation.json" --out "$S/eval-compensated" | grep -A13 'against' | sed 's/^/   /'
 $PL report stepped --evaluation "$S/eval-compensated/evaluation.json" --html "$S/report.html" | sed 's/^/   /'
-echo "   (the thesis's tables are reproduced by evaluate/stepped_separation_test; the campaign and the model"
+echo "-- the campaign (Sec. 3.5): thermal stages W6 / W1 / W7 (1000 / 3500 / 5500 rpm), W8's process error without them"
+seed=11
+for W in W6 W1 W7; do
+  $PL plan parts/stepped_workpiece.yaml --machine parts/machines/vmc3.yaml --out "$S/$W/plan" --experiment $W > /dev/null
+  $PL simulate "$S/$W/plan/roughing.ngc" "$S/$W/plan/finishing.ngc" "$S/$W/plan/probing.ngc" --machine parts/machines/vmc3.yaml \
+    --part parts/stepped_workpiece.yaml --truth examples/stepped_workpiece/truth.yaml --cmm-points "$S/$W/plan/cmm_points.csv" \
+    --schedule "$S/$W/plan/plan.json" --seed $seed --out "$S/$W/run" > /dev/null
+  $PL evaluate "$S/$W/run/cmm_export.csv" --probe-log "$S/$W/run/sw_probe.log" --manifest "$S/$W/plan/plan.json" --out "$S/$W/eval" > /dev/null
+  seed=$((seed + 1))
+done
+$PL separate --stage "$S/W6/eval/evaluation.json" --stage "$S/W1/eval/evaluation.json" --stage "$S/W7/eval/evaluation.json" \
+  --process "$S/eval/evaluation.json" --out "$S/separation" | sed 's/^/   /'
+echo "-- W3 (speeds 3500 / 5500 / 1000 / 3500 rpm step by step) predicted from the campaign"
+$PL plan parts/stepped_workpiece.yaml --machine parts/machines/vmc3.yaml --out "$S/W3/plan" --experiment W3 \
+  --predict-from "$S/separation/separation.json" | sed -n '/^Compensated/,/^Steps/p' | sed '$d' | sed 's/^/   /'
+echo "   (the thesis's tables are reproduced by evaluate/stepped_separation_test; the control errors and the model"
 echo "    loop come next: docs/stepped-workpiece.md)"
 
 echo
@@ -146,4 +161,5 @@ echo "         $OUT/eval (errors.csv, evaluation.json, report.md, campaign.gltf)
 echo "         $OUT/campaign (72 h: model.yaml, diagnosis-*.html, fit-*.html with the plots),"
 echo "         $OUT/ttp (thermal test piece: plan/, run/, cmm/ and om/ evaluations, report.html, cmm/test_piece.gltf, r-test/, fit.html),"
 echo "         $OUT/stepped (stepped workpiece W8: plan/ with the roughing, finishing, probing programs; run/ with cmm_export.csv, sw_probe.log; eval/ with compensation.json;
-         plan-compensated/, run-compensated/, eval-compensated/ with before/after; report.html)"
+         plan-compensated/, run-compensated/, eval-compensated/ with before/after; report.html;
+         W6/, W1/, W7/ the thermal stages, separation/ the campaign, W3/plan the program predicted from it)"

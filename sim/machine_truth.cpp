@@ -15,6 +15,8 @@ bool ErrorVector::any() const {
     if (v != 0) return true;
   for (double v : tool_um)
     if (v != 0) return true;
+  for (double v : scale_um_per_mm)
+    if (v != 0) return true;
   return false;
 }
 
@@ -52,6 +54,8 @@ ErrorVector readErrorVector(YamlMap& m, const std::string& suffix) {
     e.location[j] = m.numberOr(std::string(geometry::LocationErrors::names()[j]) + suffix, 0.0);
   const char* tool[] = {"tool_X_um", "tool_Y_um", "tool_Z_um"};
   for (int a = 0; a < 3; ++a) e.tool_um[a] = m.numberOr(std::string(tool[a]) + suffix, 0.0);
+  const char* scale[] = {"EXX_um_per_mm", "EYY_um_per_mm", "EZZ_um_per_mm"};
+  for (int a = 0; a < 3; ++a) e.scale_um_per_mm[a] = m.numberOr(std::string(scale[a]) + suffix, 0.0);
   return e;
 }
 

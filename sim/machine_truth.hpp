@@ -26,6 +26,10 @@ namespace probeloop::sim {
 struct ErrorVector {
   std::array<double, 7> location{};  // EX0C_um ... EC0C_urad
   std::array<double, 3> tool_um{};   // tool_X_um, tool_Y_um, tool_Z_um
+  // Linear positioning (scale) error of X, Y, Z: EXX = s x at the axis's machine coordinate x
+  // (um per mm of travel; a heated ball screw stretches its axis's scale: seed 000's thermal
+  // position error e_pt, which grows with the distance).
+  std::array<double, 3> scale_um_per_mm{};  // EXX_um_per_mm, EYY_um_per_mm, EZZ_um_per_mm
   bool any() const;
 };
 

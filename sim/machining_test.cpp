@@ -222,6 +222,15 @@ TEST(Machining, AngularErrorsActThroughTheAbbeLeverOfTheirSide) {
   EXPECT_THROW(parts::workpieceSideAxes("w X Y Z t"), std::invalid_argument);
 }
 
+// A scale error of X (EXX = s x, s = 0.5 um/mm at the machine coordinate): the tip really is at
+// x (1 + s 1e-3) when commanded to x, so it meets the face at tip centre 43 when commanded to
+// 43 / 1.0005 = 42.978511 (the log's 6 decimals).
+TEST(Machining, AScaleErrorStretchesTheAxisFromItsZero) {
+  const std::string prog = "G21 G90\nT99 M6\nG43 H99\nG0 X50 Y0 Z60\nG0 Z20\nG38.2 X38 F100\n(LOGOPEN,p.log)\n(LOG,#5061)\nM2\n";
+  const auto r = machine(truthFrom("static: {EXX_um_per_mm: 0.5}\n"), block(0.0), prog, {});
+  EXPECT_EQ(r.out.log_text, "42.978511\n");
+}
+
 // Axis motion heats a node: 10 W per m/min at F1000 for 720 s of air moves; the node's
 // sensor (no noise, no offset) follows dT = Q/G (1 - exp(-t G/C)), Q = 10 W, tau = 400 s.
 TEST(Machining, AxisMotionIsAHeatSource) {

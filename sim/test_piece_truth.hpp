@@ -53,6 +53,9 @@ struct CutState {
   Eigen::Vector3d deflection_um = Eigen::Vector3d::Zero();
   Eigen::Vector3d axes_start_um = Eigen::Vector3d::Zero(), axes_end_um = Eigen::Vector3d::Zero();
   double feed_mm_per_min = 0, spindle_rpm = 0;
+  // The axes' scale errors from the thermal nodes (and a static EXX_um_per_mm …) at the cut:
+  // the thermal position error e_pt of seed 000 is this times the travel (um per mm).
+  Eigen::Vector3d scale_um_per_mm = Eigen::Vector3d::Zero();
 };
 
 struct AsCutFeature {

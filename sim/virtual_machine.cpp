@@ -87,6 +87,7 @@ struct ProbeEvent {
   // Workpiece probing: the tool-side error of the linear axes (geometric errors and
   // squareness, not the drift) at the contact; what a CMM - probe comparison sees.
   std::optional<Vector3d> axes_um;
+  Vector3d scale_um_per_mm = Vector3d::Zero();  // the axes' scale errors (static + thermal) then
 };
 
 class VirtualMachine : public gcode::MachineInterface {
@@ -617,6 +618,16 @@ class VirtualMachine : public gcode::MachineInterface {
     return d + atc_um_;
   }
 
+  // The axes' scale errors now: static plus each node's per kelvin of its rise (um per mm).
+  Vector3d scaleUmPerMm() const {
+    Vector3d s(tr_.static_errors.scale_um_per_mm[0], tr_.static_errors.scale_um_per_mm[1],
+               tr_.static_errors.scale_um_per_mm[2]);
+    if (tr_.thermal.present)
+      for (int i = 0; i < net_.size(); ++i)
+        for (int k = 0; k < 3; ++k) s(k) += tr_.thermal.per_node_K[i].scale_um_per_mm[k] * nodeRise(i);
+    return s;
+  }
+
   std::array<double, 7> locationErrors() const {
     auto v = tr_.static_errors.location;
     const auto kf = tr_.keyframeAt(t_).values();
@@ -655,6 +666,8 @@ class VirtualMachine : public gcode::MachineInterface {
         d += trans * 1e-3 + (rot * 1e-6).cross(m_.workpiece_side[ax] ? table_lever : tool_lever);
       }
     }
+    // Scale errors (static and thermal): EXX = s x at the machine coordinate.
+    d += scaleUmPerMm().cwiseProduct(g) * 1e-3;
     // Squareness as right-hand rotations of the Y and Z axes (docs/simulator.md).
     d.x() += -tr_.EC0Y_urad * 1e-6 * g.y() + tr_.EB0Z_urad * 1e-6 * g.z();
     d.y() += -tr_.EA0Z_urad * 1e-6 * g.z();
@@ -1015,6 +1028,7 @@ class VirtualMachine : public gcode::MachineInterface {
     s.location = locationErrors();
     s.tool_um = toolDriftUm();
     s.part_above_20C_K = workpieceAbove20K();
+    s.scale_um_per_mm = scaleUmPerMm();
     cut_states_.push_back(s);
   }
 
@@ -1079,7 +1093,7 @@ class VirtualMachine : public gcode::MachineInterface {
                        {"radius_mm", r_w}, {"removed_mm3", rem.volume_mm3}, {"Ft_N", Ft}, {"Fn_N", Fn},
                        {"deflection_um", {defl.x() * 1e3, defl.y() * 1e3}},
                        {"tool_drift_um", {drift.x(), drift.y(), drift.z()}}});
-      if (tr_.axes.any || tr_.EC0Y_urad != 0 || tr_.EB0Z_urad != 0 || tr_.EA0Z_urad != 0) {
+      if (tr_.axes.any || tr_.EC0Y_urad != 0 || tr_.EB0Z_urad != 0 || tr_.EA0Z_urad != 0 || scaleUmPerMm() != Vector3d::Zero()) {
         const Vector3d a0 = axesErrorUm(pos_.xyz_mm), a1 = axesErrorUm(to.xyz_mm);
         cuts_.back()["axes_um"] = {{a0.x(), a0.y(), a0.z()}, {a1.x(), a1.y(), a1.z()}};
       }
@@ -1187,6 +1201,7 @@ class VirtualMachine : public gcode::MachineInterface {
     ev.location = locationErrors();
     ev.tool_um = toolDriftUm();
     ev.axes_um = axesErrorUm(pos_.xyz_mm + dir * s_contact);
+    ev.scale_um_per_mm = scaleUmPerMm();
     ev.atc_um = atc_um_;
     ev.settling_um = settlingUm();
     ev.artifact_dT_K = nodeRise(tr_.artifact.node);
@@ -1406,6 +1421,8 @@ SimulationOutputs simulatePrograms(const std::vector<ProgramSource>& programs, c
     je["pretravel_um"] = e.pretravel_um;
     je["noise_um"] = e.noise_um;
     if (e.axes_um) je["axes_um"] = {e.axes_um->x(), e.axes_um->y(), e.axes_um->z()};
+    if (e.scale_um_per_mm != Vector3d::Zero())
+      je["scale_um_per_mm"] = {e.scale_um_per_mm.x(), e.scale_um_per_mm.y(), e.scale_um_per_mm.z()};
     for (int j = 0; j < 7; ++j) je[std::string("apparent_") + names[j]] = e.apparent[j];
     jt["events"].push_back(je);
     auto& acc = per_cycle[p.cycle];

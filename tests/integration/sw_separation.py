@@ -10,7 +10,10 @@ and the truth file alone (not from the evaluation's code):
   contacts (truth.json events[].axes_um), +X wall minus -X wall; Z: top minus floor;
 - k_pos (um per mm of travel): the scale coefficients of truth.yaml (EXX, EYY, EZZ);
 - e_proc per step (two walls): the tool's deflection away from the material in the cuts that
-  made the two walls (truth.json features[].machine.deflection_um along each wall's normal);
+  made the two walls (truth.json features[].machine.deflection_um along each wall's normal),
+  plus the thermal position error one part cannot separate from it (the axis's scale error at
+  the cut minus at the probe's contacts, features[].machine / events[].scale_um_per_mm, over the
+  tool's travel);
 - e_splz per step: the tool's Z drift when the floor was cut minus when the top was
   (features[].machine.tool_um).
 
@@ -29,6 +32,7 @@ import csv, json, os, re, subprocess, sys, tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks  # noqa: E402
+from sw_truth import SwTruth  # noqa: E402
 
 PL = os.environ["PROBELOOP"]
 SRC = os.environ["PROBELOOP_SOURCE_DIR"]
@@ -87,18 +91,7 @@ def truth_recovery(label, run_dir, ev_dir):
     ev = json.load(open(f"{ev_dir}/evaluation.json"))
     truth = json.load(open(f"{run_dir}/truth.json"))
     feats = {f["id"]: f for f in truth["features"]}
-    axes = {}  # truth per probed feature: the axes' error at each contact
-    for e in truth["events"]:
-        axes.setdefault(feature_of[e["position"]], []).append(e["axes_um"])
-
-    def mean_axis(feature, a):
-        v = axes[feature]
-        return sum(x[a] for x in v) / len(v)
-
-    def along_normal(f, key):
-        n, d = f["as_cut"]["normal"], f["machine"][key]
-        return sum(n[i] * d[i] for i in range(3))
-
+    sw = SwTruth(truth, manifest)
     def near(name, b, t, resolved=False):
         ok = abs(b["value"] - t) <= b["U"]
         detail = f"{b['value']:.3f} vs truth {t:.3f}, U {b['U']:.3f}"
@@ -110,11 +103,11 @@ def truth_recovery(label, run_dir, ev_dir):
     for s in ev["separation"]:
         k = s["step"]
         for a, axis, P, N in ((0, "x", "XP", "XN"), (1, "y", "YP", "YN")):
-            t = mean_axis(f"S{k}_{P}", a) - mean_axis(f"S{k}_{N}", a)
+            t = sw.mean_axis(f"S{k}_{P}", a) - sw.mean_axis(f"S{k}_{N}", a)
             near(f"step {k} e_pos_{axis}", s[f"e_pos_{axis}_um"], t, resolved=k >= 3)
-            t = along_normal(feats[f"S{k}_{P}"], "deflection_um") + along_normal(feats[f"S{k}_{N}"], "deflection_um")
+            t = sw.deflection(k, a) + sw.thermal(k, a)
             near(f"step {k} e_proc_{axis} (F {s['feed_mm_per_min']:.0f})", s[f"e_proc_{axis}_um"], t, resolved=k == 4)
-        near(f"step {k} e_pos_z", s["e_pos_z_um"], mean_axis("TOP", 2) - mean_axis(f"S{k}_F", 2))
+        near(f"step {k} e_pos_z", s["e_pos_z_um"], sw.mean_axis("TOP", 2) - sw.mean_axis(f"S{k}_F", 2))
         t = feats[f"S{k}_F"]["machine"]["tool_um"][2] - feats["TOP"]["machine"]["tool_um"][2]
         near(f"step {k} e_splz (T {s['temp_state_min']:.0f} min)", s["e_splz_um"], t, resolved=k >= 2)
     # The CMM route's orientations against the surfaces as cut (truth.json normals): the walls'

@@ -1,0 +1,20 @@
+// A JSON file read whole; InputError naming the file when it is not JSON.
+#pragma once
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "core/atomic_file.hpp"
+#include "core/error.hpp"
+
+namespace probeloop::cli {
+
+inline nlohmann::json readJsonFile(const std::string& path) {
+  const std::string text = readFile(path);
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InputError(path, 0, std::string("not valid JSON (") + e.what() + ")");
+  }
+}
+
+}  // namespace probeloop::cli

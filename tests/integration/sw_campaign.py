@@ -1,0 +1,118 @@
+#!/usr/bin/env python3
+"""The stepped workpiece campaign (seed 000 Sec. 3.5-3.6): thermal stages and the process error
+with the thermal error taken out, against the simulator's truth.
+
+plan + simulate + evaluate W6 (1000 rpm), W1 (3500), W7 (5500) and W8 (changing feeds) on the
+virtual VMC of examples/stepped_workpiece/truth.yaml (its frame node stretches the X and Y
+scales with the spindle's heat: the thermal position error e_pt) -> `probeloop separate` ->
+- each stage's e_pt at each step's Temp state against the injected one, from truth.json alone
+  (the axis's scale error when the walls were cut minus when the probe touched them, over the
+  tool's travel), within U; the largest (5500 rpm, step 4) resolved;
+- W8's process error with the thermal error taken out against the tool's injected deflection,
+  within U, step 4 resolved, and closer to it than the one-part value (which holds e_pt);
+- refusals: a part cut at changing feeds given as a stage, nothing written;
+- W3 (speeds changing step by step) planned from separation.json (e_pt, e_splz interpolated in
+  S): its CMM rms error falls by 80 % or more against W3 cut uncompensated.
+
+Needs $PROBELOOP and $PROBELOOP_SOURCE_DIR. Not run under the sanitizers (six simulated parts);
+the module's unit tests (model/thermal_stages_test.cpp) are.
+"""
+import csv, json, math, os, subprocess, sys, tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402
+from sw_truth import SwTruth  # noqa: E402
+
+PL = os.environ["PROBELOOP"]
+SRC = os.environ["PROBELOOP_SOURCE_DIR"]
+W = tempfile.mkdtemp(prefix="probeloop-swcamp-")
+PIECE = f"{SRC}/parts/stepped_workpiece.yaml"
+VMC = f"{SRC}/parts/machines/vmc3.yaml"
+TRUTH = f"{SRC}/examples/stepped_workpiece/truth.yaml"
+check = Checks()
+
+
+def run(*args, cwd=None):
+    p = subprocess.run([PL, *args], capture_output=True, text=True, cwd=cwd)
+    return p.returncode, p.stdout, p.stderr
+
+
+def part(label, experiment, seed, extra=()):
+    d = f"{W}/{label}"
+    code, out, err = run("plan", PIECE, "--machine", VMC, "--out", f"{d}/plan", "--experiment", experiment, *extra)
+    check(f"plan {label}", code == 0, err)
+    code, _, err = run("simulate", "roughing.ngc", "finishing.ngc", "probing.ngc", "--machine", VMC, "--part", PIECE, "--truth", TRUTH,
+                       "--cmm-points", "cmm_points.csv", "--schedule", "plan.json", "--out", f"{d}/run", "--seed", str(seed),
+                       cwd=f"{d}/plan")
+    check(f"simulate {label}", code == 0, err)
+    code, _, err = run("evaluate", f"{d}/run/cmm_export.csv", "--probe-log", f"{d}/run/sw_probe.log", "--manifest",
+                       f"{d}/plan/plan.json", "--out", f"{d}/ev")
+    check(f"evaluate {label}", code == 0, err)
+    return d, out
+
+
+parts = {w: part(w, w, s)[0] for w, s in (("W6", 31), ("W1", 32), ("W7", 33), ("W8", 34))}
+code, out, err = run("separate", "--stage", f"{parts['W6']}/ev/evaluation.json", "--stage", f"{parts['W1']}/ev/evaluation.json",
+                     "--stage", f"{parts['W7']}/ev/evaluation.json", "--process", f"{parts['W8']}/ev/evaluation.json",
+                     "--out", f"{W}/sep")
+check("separate W6 W1 W7 + W8", code == 0 and "Thermal stages of the stepped workpiece (3)" in out, err or out)
+rows = list(csv.DictReader(open(f"{W}/sep/separation.csv")))
+sep = json.load(open(f"{W}/sep/separation.json"))
+check("separation.json states the interpolation and the thesis's swapped weights",
+      "swapped" in sep.get("interpolation", "") and len(sep["stages"]) == 3, sep.get("interpolation"))
+
+
+def truth_of(label):
+    d = parts[label]
+    return SwTruth(json.load(open(f"{d}/run/truth.json")), json.load(open(f"{d}/plan/plan.json")))
+
+
+def near(name, value, U, t, resolved=False):
+    ok = abs(value - t) <= U and (not resolved or abs(t) > U)
+    check(f"{name}: {value:.3f} vs truth {t:.3f}, U {U:.3f}", ok)
+
+
+for label, rpm in (("W6", 1000), ("W1", 3500), ("W7", 5500)):
+    t = truth_of(label)
+    for k in range(1, 5):
+        r = [x for x in rows if x["role"] == "stage" and float(x["spindle_rpm"]) == rpm and int(x["step"]) == k][0]
+        for a, ax in ((0, "x"), (1, "y")):
+            near(f"{label} ({rpm} rpm) step {k} e_pt_{ax} (T {float(r['temp_state_min']):.0f} min)", float(r[f"e_pt_{ax}_um"]),
+                 float(r[f"U_e_pt_{ax}_um"]), t.thermal(k, a), resolved=rpm == 5500 and k == 4)
+
+t8 = truth_of("W8")
+closer = [0.0, 0.0]
+for r in (x for x in rows if x["role"] == "process"):
+    k = int(r["step"])
+    for a, ax in ((0, "x"), (1, "y")):
+        d = t8.deflection(k, a)
+        near(f"W8 step {k} e_proc_{ax} (F {float(r['feed_mm_per_min']):.0f}) without e_pt", float(r[f"e_proc_{ax}_um"]),
+             float(r[f"U_e_proc_{ax}_um"]), d, resolved=k == 4)
+        closer[0] += abs(float(r[f"e_proc_{ax}_um"]) - d)
+        closer[1] += abs(float(r[f"one_part_e_proc_{ax}_um"]) - d)
+check(f"W8's process error is nearer the deflection with e_pt taken out (sum |diff| {closer[0]:.2f} against one part's {closer[1]:.2f} um)",
+      closer[0] < closer[1])
+
+# Refusals: W8 is no thermal stage; nothing is written.
+code, out, err = run("separate", "--stage", f"{parts['W8']}/ev/evaluation.json", "--out", f"{W}/bad")
+check("a part cut at changing feeds is refused as a stage, naming the file and the field",
+      code != 0 and "evaluation.json: separation[1].feed_mm_per_min: 200" in err and not os.path.exists(f"{W}/bad"), err)
+code, out, err = run("plan", PIECE, "--machine", VMC, "--out", f"{W}/bad2", "--experiment", "W3", "--predict-from",
+                     f"{parts['W8']}/run/truth.json")
+check("--predict-from a file that is neither an evaluation nor a separation is refused", code != 0 and not os.path.exists(f"{W}/bad2"), err)
+
+# W3 (speeds 3500/5500/1000/3500) predicted from the campaign, against W3 uncompensated.
+before, _ = part("W3", "W3", 41)
+after, out = part("W3-compensated", "W3", 41, ("--predict-from", f"{W}/sep/separation.json"))
+check("the W3 prediction uses the thermal stages", "thermal stages at 1000 rpm, 3500 rpm, 5500 rpm" in out, out)
+
+
+def cmm_rms(d):
+    e = json.load(open(f"{d}/ev/evaluation.json"))
+    v = [s[q] for s in e["cmm"]["steps"] for q in ("width_x_error_um", "width_y_error_um", "depth_error_um")]
+    return math.sqrt(sum(x * x for x in v) / len(v))
+
+
+rb, ra = cmm_rms(before), cmm_rms(after)
+check(f"W3 compensated from the campaign: CMM rms error {rb:.2f} -> {ra:.2f} um (80 % or more)", ra <= 0.2 * rb)
+check.finish()
