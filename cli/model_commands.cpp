@@ -10,7 +10,9 @@
 #include "core/atomic_file.hpp"
 #include "core/csv.hpp"
 #include "core/error.hpp"
+#include "cli/json_file.hpp"
 #include "model/diagnose.hpp"
+#include "model/stepped_series.hpp"
 #include "model/outputs.hpp"
 #include "model/talc.hpp"
 #include "parts/error_model_file.hpp"
@@ -26,12 +28,16 @@ struct ModelArgs {
   std::vector<std::string> models;
   std::string inputs, errors, json, report, part;
   // add
-  std::string kind, model, channels, input;
+  std::string kind, model, channels, input, lever;
   std::optional<double> tau_s, alpha, length_mm;
   bool tau_fixed = false;
   // talc
   model::TalcOptions talc;
   std::string talc_inputs;
+  // series
+  std::vector<std::string> series_parts;  // evaluation.json, inputs.csv, evaluation.json, ...
+  std::string out = "series";
+  double gap_h = 24;
 };
 
 std::string resolve(const std::string& model_file, const std::string& p) {
@@ -121,6 +127,11 @@ int runAdd(const ModelArgs& a) {
     throw InputError("", 0, "model add drift: a drift reads no input; leave out --input");
   if (*kind != model::EffectKind::Drift && a.input.empty())
     throw InputError("", 0, "model add " + a.kind + ": needs --input (an inputs.csv column)");
+  if (!a.lever.empty()) {
+    if (*kind != model::EffectKind::Static && *kind != model::EffectKind::Lag)
+      throw InputError("", 0, "model add " + a.kind + ": --lever is for a static or lag effect");
+    e.lever = a.lever;
+  }
   if (e.hasTimeConstant()) {
     e.tau_s = a.tau_s;
     e.tau_fixed = a.tau_fixed;
@@ -172,6 +183,20 @@ int runTalc(const ModelArgs& a) {
   return 0;
 }
 
+int runSeries(const ModelArgs& a) {
+  std::vector<model::SteppedSeriesPart> parts;
+  for (std::size_t i = 0; i + 1 < a.series_parts.size(); i += 2)
+    parts.push_back({readJsonFile(a.series_parts[i]), a.series_parts[i], model::loadInputs(a.series_parts[i + 1])});
+  const auto s = model::buildSteppedSeries(parts, a.gap_h * 3600.0);
+  fs::create_directories(a.out);
+  writeFileAtomic((fs::path(a.out) / "inputs.csv").string(), s.inputs_csv);
+  writeFileAtomic((fs::path(a.out) / "errors.csv").string(), s.errors_csv);
+  writeFileAtomic((fs::path(a.out) / "model.yaml").string(), s.model_yaml);
+  std::fputs(s.summary.c_str(), stdout);
+  std::printf("  wrote inputs.csv, errors.csv and model.yaml (position error only) in %s\n", a.out.c_str());
+  return 0;
+}
+
 }  // namespace
 
 std::function<int()> addModelCommands(CLI::App& app, CLI::App*& group) {
@@ -201,6 +226,7 @@ std::function<int()> addModelCommands(CLI::App& app, CLI::App*& group) {
   add->add_option("--model", a->model, "error model file to edit")->required()->check(CLI::ExistingFile);
   add->add_option("--channels", a->channels, "comma-separated channels, e.g. EY0C_um,EZ0T_um")->required();
   add->add_option("--input", a->input, "inputs.csv column the effect reads");
+  add->add_option("--lever", a->lever, "static/lag: an inputs column the effect acts over (lag spindle_rpm --lever travel_mm: a thermal scale error)");
   add->add_option("--tau-s", a->tau_s, "lag/transient: time constant to start from, s")->check(CLI::PositiveNumber);
   add->add_flag("--tau-fixed", a->tau_fixed, "keep the time constant fixed");
   add->add_option("--part", a->part, "expansion: the test piece (YAML) giving alpha and the levers")->check(CLI::ExistingFile);
@@ -222,7 +248,14 @@ std::function<int()> addModelCommands(CLI::App& app, CLI::App*& group) {
   talc->add_option("--predicted-weight", a->talc.predicted_weight, "WLS weight of rows whose target is a prediction (Eq. 4.20)")->capture_default_str();
   talc->add_option("--cycle-duration-s", a->talc.cycle_duration_s, "duration of one measurement cycle, s (Q_Prod, Eq. 6.1)")->capture_default_str()->check(CLI::PositiveNumber);
   talc->add_flag("--include-cp", a->talc.include_cp, "P99 over the whole campaign, not only after the CP");
-  return [a, fit, cmp, dia, add, talc]() -> int {
+  auto* series = group->add_subcommand("series", "Stepped workpiece: several parts' evaluations and logged inputs -> one campaign "
+                                       "(inputs.csv, errors.csv, a position-only model.yaml) for fit, diagnose and add");
+  series->add_option("--part", a->series_parts, "a part's evaluation.json and its machine's inputs.csv (repeat, in cut order)")
+      ->required()->type_size(2)->allow_extra_args(false)->check(CLI::ExistingFile);
+  series->add_option("--gap-h", a->gap_h, "hours the machine stands between two parts")->capture_default_str()->check(CLI::NonNegativeNumber);
+  series->add_option("--out", a->out, "output folder")->capture_default_str();
+  return [a, fit, cmp, dia, add, talc, series]() -> int {
+    if (*series) return runSeries(*a);
     if (*talc) return runTalc(*a);
     if (*fit) return runFit(*a);
     if (*cmp) return runCompare(*a);

@@ -254,6 +254,7 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoi
     throw InputError(m.file, 0, "stepped_workpiece.sizes_mm: no steps to evaluate");
   std::vector<std::array<Budget, 3>> pos;  // per step: x, y, z
   std::vector<std::array<double, 3>> u_own;  // per step: the part of u_c that is the step's own (not a common scale)
+  std::vector<std::array<double, 3>> u_cmm(e.probe.steps.size());  // per step: the CMM's measurement alone
   for (std::size_t i = 0; i < e.probe.steps.size(); ++i) {
     const auto &c = e.cmm.steps[i], &p = e.probe.steps[i];
     const int k = c.step;
@@ -280,6 +281,7 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoi
           contribution("part temperature on the machine", 'B', "rectangular",
                        "20 C +- " + formatNumber(kMachinePartHalfWidthK) + " K (not measured)", alpha * L * kMachinePartHalfWidthK / kSqrt3)};
       b[a] = uncertainty::combine(std::string("e_pos_") + axes[a] + "_um", "um", value, cs);
+      u_cmm[i][static_cast<std::size_t>(a)] = std::hypot(mpe(L) / kSqrt3, u_fit_cmm, alpha * L * dT_cmm / kSqrt3);
       // The step's own part of u_c: repeatability, the CMM's planes and the MPE's constant.
       own[a] = std::sqrt(u_rep * u_rep + u_fit_cmm * u_fit_cmm + std::pow(m.sw.cmm.mpe_constant_um / kSqrt3, 2));
     }
@@ -333,6 +335,9 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoi
       s.feed_mm_per_min = m.sw.steps[i].feed_xy_mm_per_min;
       s.spindle_rpm = m.sw.steps[i].spindle_speed_rpm;
       s.temp_state_min = m.sw.steps[i].temp_state_min;
+      s.cut_start_s = m.sw.steps[i].start_s;
+      s.cut_end_s = m.sw.steps[i].end_s;
+      s.cut_mid_s = m.sw.steps.front().start_s + 60.0 * s.temp_state_min;
     }
     // A compensated plan cut each wall `wall_um` inside and each floor `floor_um` higher on
     // purpose: the process and spindle errors are against what was commanded, and the
@@ -347,6 +352,7 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoi
     }
     s.travel_probe_mm = p.size_mm + d_probe;
     s.travel_tool_mm = p.size_mm + d_tool;
+    for (int a = 0; a < 3; ++a) s.u_cmm_um[a] = u_cmm[i][static_cast<std::size_t>(a)];
     s.e_pos_x_um = pos[i][0];
     s.e_pos_y_um = pos[i][1];
     s.e_pos_z_um = pos[i][2];
@@ -515,7 +521,9 @@ std::string swEvaluationJson(const SwEvaluation& e) {
   j["k_pos_z_um_per_mm"] = budgetJson(e.k_pos_z_um_per_mm);
   for (const auto& s : e.steps)
     j["separation"].push_back({{"step", s.step}, {"feed_mm_per_min", s.feed_mm_per_min}, {"spindle_rpm", s.spindle_rpm},
-                               {"temp_state_min", s.temp_state_min}, {"travel_probe_mm", s.travel_probe_mm},
+                               {"temp_state_min", s.temp_state_min}, {"cut_start_s", s.cut_start_s},
+                               {"cut_end_s", s.cut_end_s}, {"cut_mid_s", s.cut_mid_s}, {"u_cmm_width_x_um", s.u_cmm_um[0]},
+                               {"u_cmm_width_y_um", s.u_cmm_um[1]}, {"u_cmm_depth_um", s.u_cmm_um[2]}, {"travel_probe_mm", s.travel_probe_mm},
                                {"travel_tool_mm", s.travel_tool_mm}, {"e_pos_x_um", budgetJson(s.e_pos_x_um)},
                                {"e_pos_y_um", budgetJson(s.e_pos_y_um)}, {"e_pos_z_um", budgetJson(s.e_pos_z_um)},
                                {"e_proc_x_um", budgetJson(s.e_proc_x_um)}, {"e_proc_y_um", budgetJson(s.e_proc_y_um)},

@@ -81,7 +81,13 @@ struct SwSourceGeometry {
 struct SwStepSeparation {
   int step = 0;
   double feed_mm_per_min = 0, spindle_rpm = 0, temp_state_min = 0;
+  // On the programs' clock (the simulator's inputs.csv clock): the step's cuts, and the mid-time
+  // of its wall cuts (step 1's start + T), the time its widths belong to.
+  double cut_start_s = 0, cut_end_s = 0, cut_mid_s = 0;
   double travel_probe_mm = 0, travel_tool_mm = 0;  // size + stylus d, size + tool d
+  // The CMM's measurement of the width X, Y and the depth: its MPE at the length, its planes'
+  // residuals, the part's temperature at the CMM (what a series of CMM errors carries).
+  double u_cmm_um[3] = {0, 0, 0};
   uncertainty::Budget e_pos_x_um, e_pos_y_um, e_pos_z_um;
   uncertainty::Budget e_proc_x_um, e_proc_y_um;  // two-wall sums (L1639: half per wall)
   uncertainty::Budget e_splz_um;

@@ -46,6 +46,11 @@ std::vector<Effect> candidatesFor(const Campaign& c, const ChannelModel& cm, con
     out.push_back(e);
   };
   add(makeEffect(EffectKind::Drift));
+  // Lengths the channel already reads (a position error over a distance, static(travel_mm)):
+  // a heat source's lag may act over them too, a thermal scale error (lag x lever).
+  std::vector<std::string> levers;
+  for (const auto& have : cm.effects)
+    if (have.kind == EffectKind::Static && have.lever.empty() && endsWith(have.input, "_mm")) levers.push_back(have.input);
   for (const auto& name : c.inputs.names) {
     if (isTemperature(name)) {
       add(makeEffect(EffectKind::Static, name));
@@ -61,6 +66,11 @@ std::vector<Effect> candidatesFor(const Campaign& c, const ChannelModel& cm, con
       add(makeEffect(EffectKind::Transient, name));
     } else if (isSpeedInput(name) || endsWith(name, "_on")) {
       add(makeEffect(EffectKind::Lag, name));
+      for (const auto& L : levers) {
+        Effect e = makeEffect(EffectKind::Lag, name);
+        e.lever = L;
+        add(e);
+      }
       // A feed also loads the cut: the force grows with it at once (seed 000 Eq. 3.16).
       if (name.rfind("feed", 0) == 0) add(makeEffect(EffectKind::Static, name));
     } else {
@@ -114,6 +124,10 @@ std::string sentence(const Recommendation& r, const std::string& what) {
              minutes(*e.tau_s) + ": " + physics(e, what) + ".";
     case EffectKind::Static: return chs + verb + e.input + " with no delay: " + physics(e, what) + ".";
     case EffectKind::Lag:
+      if (!e.lever.empty())
+        return chs + verb + (isSpeedInput(e.input) ? e.input + " (its magnitude)" : e.input) + " through a lag of ~" +
+               minutes(*e.tau_s) + ", times " + e.lever + ": " + physics(e, what) +
+               ", and it acts over the distance: the warmed screws or frame stretch the axis (a thermal scale error).";
       return chs + verb + (isSpeedInput(e.input) ? e.input + " (its magnitude)" : e.input) + " through a lag of ~" +
              minutes(*e.tau_s) + ": " + physics(e, what) + ".";
     case EffectKind::Offset: break;
@@ -126,6 +140,7 @@ std::string command(const Recommendation& r, const DiagnoseOptions& opt) {
   for (const auto& c : r.channels) chs += (chs.empty() ? "" : ",") + c.channel;
   std::string cmd = std::string("probeloop model add ") + kindName(r.effect.kind) + " --model " + opt.model_path + " --channels " + chs;
   if (!r.effect.input.empty()) cmd += " --input " + r.effect.input;
+  if (!r.effect.lever.empty()) cmd += " --lever " + r.effect.lever;
   if (r.effect.hasTimeConstant() && r.effect.tau_s) cmd += " --tau-s " + fmt(*r.effect.tau_s, 0);
   if (r.effect.kind == EffectKind::Expansion) cmd += " --part " + opt.part_path;
   return cmd;

@@ -51,7 +51,7 @@ std::optional<EffectKind> kindFromName(const std::string& name) {
 
 std::string Effect::id() const {
   if (kind == EffectKind::Offset || kind == EffectKind::Drift) return kindName(kind);
-  return std::string(kindName(kind)) + "(" + input + ")";
+  return std::string(kindName(kind)) + "(" + input + ")" + (lever.empty() ? "" : "*" + lever);
 }
 
 bool isSpeedInput(const std::string& c) {

@@ -17,6 +17,9 @@
 //   transient  k s,  s jumps by each event, tau ds/dt = -s   (tool changes: a settling step)
 //   expansion  alpha L (T - T0)                    artifact/workpiece/table growth; alpha and
 //                                                  L are known, nothing is fitted
+// A static or lag effect may act over a lever: its regressor times another inputs column
+// (`lever`), e.g. lag(spindle_rpm) x travel_mm: a warmed screw or frame stretches its axis, an
+// error that grows with the heat and with the distance (seed 000's thermal position error e_pt).
 // Contract: regressor() is finite for finite inputs; tau > 0; an input column that does not
 // exist is an InputError naming the columns there are.
 #pragma once
@@ -54,9 +57,10 @@ struct Effect {
   bool tau_fixed = false;
   double alpha_um_per_m_K = 0;       // expansion
   double length_mm = 0;              // expansion
+  std::string lever;                 // static/lag: the regressor times this inputs column ("" none)
   bool just_added = false;           // set by `probeloop model add`: "before" leaves it out
 
-  std::string id() const;            // e.g. "lag(c_rpm)", "offset", "expansion(T_table_C)"
+  std::string id() const;            // e.g. "lag(c_rpm)", "offset", "expansion(T_table_C)", "lag(spindle_rpm)*travel_mm"
   bool hasTimeConstant() const { return kind == EffectKind::Lag || kind == EffectKind::Transient; }
   bool fitsGain() const { return kind != EffectKind::Expansion; }
 };

@@ -37,6 +37,7 @@ class ChannelRegression {
       if (e.kind == EffectKind::Drift) {
         columns_.push_back(&e);
         col_input_.push_back(-1);
+        col_lever_.push_back(-1);
         continue;
       }
       const int col = c.inputs.column(e.input);
@@ -60,8 +61,18 @@ class ChannelRegression {
         fixed_ += Eigen::Map<const Eigen::VectorXd>(r.data(), N);
         continue;
       }
+      int lever = -1;
+      if (!e.lever.empty()) {
+        lever = c.inputs.column(e.lever);
+        if (lever < 0) {
+          std::string have;
+          for (const auto& s : c.inputs.names) have += (have.empty() ? "" : ", ") + s;
+          throw InputError(c.inputs.file, 0, name_ + ": " + e.id() + ": no input column '" + e.lever + "' for the lever; the inputs are: " + have);
+        }
+      }
       columns_.push_back(&e);
       col_input_.push_back(col);
+      col_lever_.push_back(lever);
       if (e.hasTimeConstant()) nonlinear_.push_back(static_cast<int>(columns_.size()) - 1);
     }
   }
@@ -94,6 +105,10 @@ class ChannelRegression {
       for (int k = 0; k < N; ++k) r[k] = (c_.errors.t_s[k] - c_.inputs.t_s[0]) / 3600.0;
     } else {
       r = c_.atErrorTimes(regressor(e, c_.inputs.t_s, c_.inputs.columns[col_input_[j]], tau));
+      if (col_lever_[j] >= 0) {  // acting over a distance: the regressor times the lever there
+        const auto L = c_.atErrorTimes(c_.inputs.columns[col_lever_[j]]);
+        for (int k = 0; k < N; ++k) r[k] *= L[k];
+      }
     }
     return Eigen::Map<const Eigen::VectorXd>(r.data(), N);
   }
@@ -132,6 +147,7 @@ class ChannelRegression {
   std::string name_;
   Eigen::VectorXd y_, fixed_;
   std::vector<const Effect*> columns_;
+  std::vector<int> col_lever_;  // per column: the lever's inputs.csv column (-1: none)
   std::vector<int> col_input_, nonlinear_;  // per column: its inputs.csv column (-1: drift); the lag/transient columns
 };
 
@@ -155,6 +171,8 @@ std::string inputUnit(const std::string& c) {
   if (endsWith(c, "_C") || endsWith(c, "_K")) return "K";
   if (endsWith(c, "_rpm")) return "rpm";
   if (endsWith(c, "_mm_per_min")) return "(mm/min)";
+  if (endsWith(c, "_mm")) return "mm";
+  if (endsWith(c, "_um")) return "um";
   if (endsWith(c, "_on")) return "on";
   if (c == "tool_changes") return "change";
   return "unit";
@@ -292,7 +310,8 @@ ChannelFit fitChannel(const Campaign& c, const std::string& channel, const std::
   for (int j = 0; j < m - 1; ++j) {
     FittedEffect fe;
     fe.effect = reg.columnEffect(j);
-    const std::string gunit = fe.effect.kind == EffectKind::Drift ? fit.unit + "/h" : fit.unit + "/" + inputUnit(fe.effect.input);
+    std::string gunit = fe.effect.kind == EffectKind::Drift ? fit.unit + "/h" : fit.unit + "/" + inputUnit(fe.effect.input);
+    if (!fe.effect.lever.empty()) gunit = fit.unit + "/(" + inputUnit(fe.effect.input) + " " + inputUnit(fe.effect.lever) + ")";
     fe.parameters.push_back({fe.effect.kind == EffectKind::Drift ? "b" : "k", gunit, theta(1 + j), std::sqrt(cov(1 + j, 1 + j))});
     for (int i = 0; i < q; ++i)
       if (reg.nonlinear()[i] == j) {

@@ -134,8 +134,11 @@ std::vector<SteppedPrediction> predictSteppedErrors(const SteppedPredictor& p, c
     SteppedPrediction r;
     r.step = c.step;
     const double L = c.size_mm + p.tool_d_mm, scale = p.speed_ref_rpm > 0 ? c.spindle_rpm / p.speed_ref_rpm : 1.0;
-    r.width_x_um = p.k_um_per_mm[0] * L + p.proc_x.at(c.feed_mm_per_min);
-    r.width_y_um = p.k_um_per_mm[1] * L + p.proc_y.at(c.feed_mm_per_min);
+    if (p.proc_per_rev && !(c.spindle_rpm > 0))
+      throw GeometryError("step " + std::to_string(c.step) + ": the process error per revolution needs a spindle speed > 0");
+    const double fx = p.proc_per_rev ? 1000.0 * c.feed_mm_per_min / c.spindle_rpm : c.feed_mm_per_min;
+    r.width_x_um = p.k_um_per_mm[0] * L + p.proc_x.at(fx);
+    r.width_y_um = p.k_um_per_mm[1] * L + p.proc_y.at(fx);
     const double Lp = c.size_mm + p.probe_d_mm;
     r.U_width_x_um = std::hypot(2 * p.u_k_um_per_mm[0] * Lp, p.proc_x.k95 * p.proc_x.u_pred_um);
     r.U_width_y_um = std::hypot(2 * p.u_k_um_per_mm[1] * Lp, p.proc_y.k95 * p.proc_y.u_pred_um);

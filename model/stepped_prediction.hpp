@@ -55,6 +55,9 @@ struct SteppedPredictor {
   SteppedComponent proc_x, proc_y, splz;
   // From a campaign: the thermal terms; absent (one part): e_pt 0, e_splz scaled by S / S_ref.
   std::function<ThermalTerms(double temp_state_min, double spindle_rpm)> thermal;
+  // e_proc against the feed per revolution, 1000 F / S in um (a campaign's, with the stages'
+  // intercepts); else against the feed (one part, one speed).
+  bool proc_per_rev = false;
   std::string thermal_summary;
 };
 

@@ -197,18 +197,30 @@ std::vector<ProcessStep> separateProcess(const ThermalStages& st, const json& e,
 SteppedPredictor steppedPredictorFromCampaign(const ThermalStages& st, const json& process, const std::string& file) {
   SteppedPredictor p = steppedPredictorFromEvaluation(process, file);
   // e_proc(F) refitted to the process part's steps with the thermal error taken out.
+  // The process error against the feed per revolution (the chip load, 1000 F / S): the process
+  // part's steps with e_pt taken out, and each stage's intercept, its process error at its own
+  // speed (the stages cut at 1000 and 5500 rpm load the tool differently at the same feed).
   const auto steps = separateProcess(st, process, file);
-  std::vector<double> F, px, ux, py, uy;
+  std::vector<double> f, px, ux, py, uy;
   for (const auto& s : steps) {
-    F.push_back(s.feed_mm_per_min);
+    if (!(s.spindle_rpm > 0)) throw InputError(file, 0, "separation[].spindle_rpm: must be positive");
+    f.push_back(1000.0 * s.feed_mm_per_min / s.spindle_rpm);
     px.push_back(s.e_proc_x_um);
     ux.push_back(s.u_e_proc_x_um);
     py.push_back(s.e_proc_y_um);
     uy.push_back(s.u_e_proc_y_um);
   }
+  for (const auto& g : st.stages) {
+    f.push_back(1000.0 * g.feed_mm_per_min / g.spindle_rpm);
+    px.push_back(g.intercept_x_um());
+    ux.push_back(g.one_part_x.u_pred_um);
+    py.push_back(g.intercept_y_um());
+    uy.push_back(g.one_part_y.u_pred_um);
+  }
   const std::vector<Candidate> feed_forms{{Family::Polynomial, 1, true}, {Family::Polynomial, 2, true}, {Family::Hyperbolic, 0, false}};
-  p.proc_x = fitSteppedComponent("e_proc_x_um", "feed_mm_per_min", F, px, ux, feed_forms, file);
-  p.proc_y = fitSteppedComponent("e_proc_y_um", "feed_mm_per_min", F, py, uy, feed_forms, file);
+  p.proc_x = fitSteppedComponent("e_proc_x_um", "feed_per_rev_um", f, px, ux, feed_forms, file);
+  p.proc_y = fitSteppedComponent("e_proc_y_um", "feed_per_rev_um", f, py, uy, feed_forms, file);
+  p.proc_per_rev = true;
   p.thermal = [st](double T, double S) {
     ThermalTerms t;
     const auto x = st.at(ThermalComponent::PtX, T, S), y = st.at(ThermalComponent::PtY, T, S), z = st.at(ThermalComponent::Splz, T, S);

@@ -95,11 +95,39 @@ TEST(ThermalStages, TheProcessPartLosesItsThermalError) {
   const auto p = steppedPredictorFromCampaign(st, w8, "w8.json");
   const auto r = predictSteppedErrors(p, {{1, 60, 25, 300, 4500, 150}});
   ASSERT_EQ(r.size(), 1u);
-  // e_proc(300) through 0 on points 0.8 + 0.008 F: the best form is not exact; only the thermal
-  // term is checked here: at 4500 rpm halfway between 3500 and 5500.
+  // e_proc against the feed per revolution (1000 F / S); only the thermal term is checked here:
+  // at 4500 rpm halfway between 3500 and 5500.
+  EXPECT_TRUE(p.proc_per_rev);
+  EXPECT_EQ(p.proc_x.variable, "feed_per_rev_um");
   const double pt = 0.5 * 0.021 * 150 + 0.5 * 0.033 * 150;
-  EXPECT_NEAR(r[0].width_x_um - 0.15 * 70 - p.proc_x.at(300), pt, 1e-6);
+  EXPECT_NEAR(r[0].width_x_um - 0.15 * 70 - p.proc_x.at(1000.0 * 300 / 4500), pt, 1e-6);
   EXPECT_NEAR(r[0].depth_um, 0.02 * 25 - (0.5 * 0.07 + 0.5 * 0.11) * 150, 1e-6);
+}
+
+// The process error follows the chip load f = 1000 F / S (um per revolution), e_proc = 0.03 f: the
+// stages' intercepts (F 100 at 1000, 3500, 5500 rpm: 3, 0.857, 0.545 um) and W8's steps (F 100-800
+// at 3500 rpm, with e_pt 0.021 T taken out) lie on one line through 0; a step at 1000 rpm and
+// F 200 (f = 200, beyond W8's 229 only in feed) is predicted 6 um, which W8's feeds alone (at
+// 3500 rpm, f = F / 3.5) would put at 0.03 x 57.1 = 1.71 um.
+TEST(ThermalStages, TheCampaignsProcessErrorFollowsTheChipLoad) {
+  auto c = [](double F, double S) { return 0.03 * 1000 * F / S; };
+  const auto st = thermalStagesFromEvaluations({{part("W6", 1000, kF100, c(100, 1000), 0.006, 0.02), "w6.json"},
+                                                {part("W1", 3500, kF100, c(100, 3500), 0.021, 0.07), "w1.json"},
+                                                {part("W7", 5500, kF100, c(100, 5500), 0.033, 0.11), "w7.json"}});
+  const double F[4] = {100, 200, 400, 800};
+  json w8 = part("W8", 3500, F, 0, 0.021, 0.07, 0.03 / 3.5);
+  w8["k_pos_x_um_per_mm"] = budget(0, 0.01);
+  w8["k_pos_y_um_per_mm"] = budget(0, 0.01);
+  w8["k_pos_z_um_per_mm"] = budget(0, 0.01);
+  for (int i = 0; i < 4; ++i) {
+    w8["separation"][i]["travel_probe_mm"] = 32 + 15 * i;
+    w8["separation"][i]["travel_tool_mm"] = 40 + 15 * i;
+    w8["cmm"]["steps"].push_back({{"step", i + 1}, {"size_mm", 30 + 15 * i}});
+  }
+  const auto p = steppedPredictorFromCampaign(st, w8, "w8.json");
+  EXPECT_NEAR(p.proc_x.at(200), 6.0, 1e-6);
+  const auto r = predictSteppedErrors(p, {{1, 60, 25, 200, 1000, 0}});
+  EXPECT_NEAR(r[0].width_x_um, 6.0, 1e-6);  // k = 0, T = 0: e_pt 0
 }
 
 TEST(ThermalStages, RefusesWhatIsNotAStage) {

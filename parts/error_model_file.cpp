@@ -34,6 +34,11 @@ Effect readEffect(YamlMap& m) {
     // and measured cold reads smaller, so its diameter's lever is negative).
     if (!(e.length_mm != 0)) m.fail("length", "must not be 0 (signed lever of the part's growth, mm)");
   }
+  if (m.has("lever")) {
+    if (e.kind != EffectKind::Static && e.kind != EffectKind::Lag)
+      m.fail("lever", "only a static or lag effect acts over a lever (an inputs column it is multiplied by)");
+    e.lever = m.string("lever");
+  }
   e.just_added = m.booleanOr("just_added", false);
   m.finish();
   return e;
@@ -116,6 +121,7 @@ std::string errorModelYaml(const model::ErrorModel& m) {
       if (!e.input.empty()) o << ", input: " << quoted(e.input);
       if (e.tau_s) o << ", tau: " << formatNumber(*e.tau_s) << " s";
       if (e.tau_fixed) o << ", tau_fixed: true";
+      if (!e.lever.empty()) o << ", lever: " << quoted(e.lever);
       if (e.kind == EffectKind::Expansion)
         o << ", alpha_um_per_m_K: " << formatNumber(e.alpha_um_per_m_K) << ", length: " << formatNumber(e.length_mm) << " mm";
       if (e.just_added) o << ", just_added: true";

@@ -152,8 +152,29 @@ $PL separate --stage "$S/W6/eval/evaluation.json" --stage "$S/W1/eval/evaluation
 echo "-- W3 (speeds 3500 / 5500 / 1000 / 3500 rpm step by step) predicted from the campaign"
 $PL plan parts/stepped_workpiece.yaml --machine parts/machines/vmc3.yaml --out "$S/W3/plan" --experiment W3 \
   --predict-from "$S/separation/separation.json" | sed -n '/^Compensated/,/^Steps/p' | sed '$d' | sed 's/^/   /'
-echo "   (the thesis's tables are reproduced by evaluate/stepped_separation_test; the control errors and the model"
-echo "    loop come next: docs/stepped-workpiece.md)"
+echo "-- the model loop (§9.1 item 10): W8, W6, W1, W7 and W3 cut plain as one series, from the position error only;"
+echo "   each round adds what the diagnosis names first (its printed command)"
+$PL plan parts/stepped_workpiece.yaml --machine parts/machines/vmc3.yaml --out "$S/W3plain/plan" --experiment W3 > /dev/null
+$PL simulate "$S/W3plain/plan/roughing.ngc" "$S/W3plain/plan/finishing.ngc" "$S/W3plain/plan/probing.ngc" --machine parts/machines/vmc3.yaml \
+  --part parts/stepped_workpiece.yaml --truth examples/stepped_workpiece/truth.yaml --cmm-points "$S/W3plain/plan/cmm_points.csv" \
+  --schedule "$S/W3plain/plan/plan.json" --seed 14 --out "$S/W3plain/run" > /dev/null
+$PL evaluate "$S/W3plain/run/cmm_export.csv" --probe-log "$S/W3plain/run/sw_probe.log" --manifest "$S/W3plain/plan/plan.json" \
+  --out "$S/W3plain/eval" > /dev/null
+$PL model series --part "$S/eval/evaluation.json" "$S/run/inputs.csv" --part "$S/W6/eval/evaluation.json" "$S/W6/run/inputs.csv" \
+  --part "$S/W1/eval/evaluation.json" "$S/W1/run/inputs.csv" --part "$S/W7/eval/evaluation.json" "$S/W7/run/inputs.csv" \
+  --part "$S/W3plain/eval/evaluation.json" "$S/W3plain/run/inputs.csv" --out "$S/series" | sed 's/^/   /'
+for round in 1 2 3 4; do
+  $PL model diagnose "$S/series/model.yaml" > "$S/series/diagnosis-$round.txt"
+  cmd=$(sed -n 's/^   add it: //p' "$S/series/diagnosis-$round.txt" | head -1)
+  [ -n "$cmd" ] || break
+  score=$(sed -n 's/^1\. .*(score \([0-9.]*\)).*/\1/p' "$S/series/diagnosis-$round.txt")
+  awk -v s="$score" 'BEGIN { exit !(s >= 1) }' || break
+  echo "   round $round: $(sed -n 's/^1\. //p' "$S/series/diagnosis-$round.txt")"
+  $PL ${cmd#probeloop } > /dev/null
+  $PL model fit "$S/series/model.yaml" | grep -E '^[a-z_]+_um  |validation  |validation, before' | sed 's/^/     /'
+done
+echo "   (the thesis's tables are reproduced by evaluate/stepped_separation_test; the control errors come next:"
+echo "    docs/stepped-workpiece.md)"
 
 echo
 echo "Outputs: $OUT/plan (G-code, manifest), $OUT/run (controller log, points.csv, inputs.csv, truth.json),"
@@ -162,4 +183,5 @@ echo "         $OUT/campaign (72 h: model.yaml, diagnosis-*.html, fit-*.html wit
 echo "         $OUT/ttp (thermal test piece: plan/, run/, cmm/ and om/ evaluations, report.html, cmm/test_piece.gltf, r-test/, fit.html),"
 echo "         $OUT/stepped (stepped workpiece W8: plan/ with the roughing, finishing, probing programs; run/ with cmm_export.csv, sw_probe.log; eval/ with compensation.json;
          plan-compensated/, run-compensated/, eval-compensated/ with before/after; report.html;
-         W6/, W1/, W7/ the thermal stages, separation/ the campaign, W3/plan the program predicted from it)"
+         W6/, W1/, W7/ the thermal stages, separation/ the campaign, W3/plan the program predicted from it,
+         W3plain/, series/ the model loop's inputs.csv, errors.csv, model.yaml and each round's diagnosis)"

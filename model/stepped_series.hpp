@@ -1,0 +1,49 @@
+// The stepped workpiece's error series for the model loop (seed 000 §9.1 item 10; docs/
+// stepped-workpiece.md §9): several parts' evaluations and their machines' logged inputs ->
+// one campaign on one clock that `probeloop model fit|diagnose|add` reads.
+//
+// errors.csv: one row per step of each part at the mid-time of its wall cuts (evaluation.json's
+// cut_mid_s), channels the CMM's errors width_x_um, width_y_um, depth_um, U = 2 u of the CMM's
+// measurement (separation[].u_cmm_…: its MPE at the length, its planes' residuals, the part's
+// temperature at the CMM).
+// inputs.csv: the parts' logged inputs one after the other, each part shifted to start
+// `gap_s` after the previous one's last sample (the machine stood between the experiments,
+// which the thesis cut on different days): in the gap the speeds, the fluid and the tool
+// changes are 0 and every other column (temperatures) goes linearly from its last value to
+// the next part's first. Derived columns, the conditions of the step being cut (held from one
+// step's start to the next's, so that a mid-cut sample reads its own step's):
+//   travel_mm              size + tool d: the tool centre's travel between opposite walls
+//                          (a position error proportional to the distance reads it);
+//   depth_mm               the floor's nominal depth below the top;
+//   cut_feed_mm_per_min    the step's XY feed (the thesis's process variable);
+//   feed_per_rev_um        the feed per spindle revolution, 1000 F / S (the chip load);
+// model.yaml: the starting model "position error only": static(travel_mm) for the widths,
+// static(depth_mm) for the depth, trained on the first 60 % of the rows.
+//
+// Contract: InputError naming the file: not a stepped evaluation, a step without cut_mid_s
+// (an evaluation older than this series), inputs whose columns or step differ from the first
+// part's, a cut time outside its part's inputs; parts in the order given.
+#pragma once
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "model/dataset.hpp"
+
+namespace probeloop::model {
+
+struct SteppedSeriesPart {
+  nlohmann::json evaluation;
+  std::string evaluation_file;
+  InputSeries inputs;
+};
+
+struct SteppedSeries {
+  std::string inputs_csv, errors_csv, model_yaml;
+  int rows = 0;
+  std::string summary;
+};
+
+SteppedSeries buildSteppedSeries(const std::vector<SteppedSeriesPart>& parts, double gap_s = 24 * 3600.0);
+
+}  // namespace probeloop::model
