@@ -91,6 +91,39 @@ TEST(FitChannel, RecoversGainAndTimeConstantOfALagWithHonestUncertainty) {
   EXPECT_LT(f.validation.rmse, 1.2 * 0.3);  // the validation span is predicted from the inputs alone
 }
 
+// A lag acting over a lever (a thermal scale error): the error is k x(t) L(t) with L a second
+// input (a travel that changes every 6 h); the fit recovers k and tau, and the same lag without
+// the lever cannot explain it.
+TEST(FitChannel, ALagOverALeverIsTheLagTimesTheLever) {
+  auto s = makeCampaign(0, 2400, 0.2, 11);
+  auto& in = s.c.inputs;
+  in.names.push_back("travel_mm");
+  in.columns.push_back({});
+  for (double t : in.t_s) in.columns.back().push_back(40 + 20 * (static_cast<int>(t / 21600) % 4));
+  const double k = 2e-4;  // um per rpm per mm: 0.24 um/mm at 1200 rpm
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0, 0.2);
+  for (std::size_t i = 0; i < s.c.errors.t_s.size(); ++i) {
+    const double L = 40 + 20 * (static_cast<int>(s.c.errors.t_s[i] / 21600) % 4);
+    s.c.errors.values[0][i] = 1.0 + k * s.lag_caxis[i] * L + noise(rng);
+  }
+  Effect scale = makeEffect(EffectKind::Lag, "c_rpm");
+  scale.lever = "travel_mm";
+  EXPECT_EQ(scale.id(), "lag(c_rpm)*travel_mm");
+  const int n = trainingEnd(s.c.errors.size(), 0.6);
+  const auto f = fitChannel(s.c, "EY0C_um", {scale}, n);
+  const auto& p = f.effects[1].parameters;
+  EXPECT_NEAR(p[0].value, k, 4 * p[0].u);
+  EXPECT_NEAR(p[1].value, 2400, 4 * p[1].u);
+  EXPECT_EQ(p[0].unit, "um/(rpm mm)");
+  EXPECT_LT(f.validation.rmse, 1.3 * 0.2);
+  const auto plain = fitChannel(s.c, "EY0C_um", {makeEffect(EffectKind::Lag, "c_rpm")}, n);
+  EXPECT_GT(plain.validation.rmse, 3 * f.validation.rmse);
+  Effect missing = scale;
+  missing.lever = "no_such_mm";
+  EXPECT_THROW(fitChannel(s.c, "EY0C_um", {missing}, n), InputError);
+}
+
 TEST(FitChannel, RefusesWhatCannotBeIdentified) {
   const auto s = makeCampaign(0.012, 2400, 0.3, 7);
   const int n = trainingEnd(s.c.errors.size(), 0.6);

@@ -55,12 +55,14 @@ SteppedSeries buildSteppedSeries(const std::vector<SteppedSeriesPart>& parts, do
       const double last_t = t_all.back();
       const long n_gap = std::lround(std::ceil(gap_s / step));
       const double next_t = last_t + (n_gap + 1) * step;
+      std::vector<double> last(names.size());
+      for (std::size_t c = 0; c < names.size(); ++c) last[c] = cols[c].back();
       for (long k = 1; k <= n_gap; ++k) {
         const double f = static_cast<double>(k) / (n_gap + 1);
         t_all.push_back(last_t + k * step);
         for (std::size_t c = 0; c < names.size(); ++c) {
           const bool off = isSpeedInput(names[c]) || isEventOrSwitch(names[c]);
-          cols[c].push_back(off ? 0.0 : cols[c].back() * (1 - f) + in.columns[c].front() * f);
+          cols[c].push_back(off ? 0.0 : last[c] * (1 - f) + in.columns[c].front() * f);
         }
       }
       offset = next_t - in.t_s.front();

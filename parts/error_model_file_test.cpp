@@ -32,7 +32,9 @@ TEST(ErrorModelFile, WhatIsWrittenLoadsBackTheSame) {
   model::Effect exp = model::makeEffect(model::EffectKind::Expansion, "T_table_C");
   exp.alpha_um_per_m_K = 11.5;
   exp.length_mm = 90;
-  m.channels = {{"EY0C_um", {lag, model::makeEffect(model::EffectKind::Drift)}}, {"EZ0T_um", {fixed, exp}}, {"EX0C_um", {}}};
+  model::Effect scale = model::makeEffect(model::EffectKind::Lag, "spindle_rpm");
+  scale.lever = "travel_mm";
+  m.channels = {{"EY0C_um", {lag, model::makeEffect(model::EffectKind::Drift)}}, {"EZ0T_um", {fixed, exp}}, {"EX0C_um", {scale}}};
   const auto path = tempFile("roundtrip.yaml", "");
   parts::saveErrorModel(m, path);
   const auto back = parts::loadErrorModel(path);
@@ -54,6 +56,7 @@ TEST(ErrorModelFile, WhatIsWrittenLoadsBackTheSame) {
       EXPECT_EQ(b.just_added, a.just_added);
       EXPECT_EQ(b.alpha_um_per_m_K, a.alpha_um_per_m_K);
       EXPECT_EQ(b.length_mm, a.length_mm);
+      EXPECT_EQ(b.lever, a.lever);
     }
   }
   EXPECT_EQ(parts::errorModelYaml(back), parts::errorModelYaml(m));
@@ -79,4 +82,7 @@ TEST(ErrorModelFile, RefusesBadFilesWithTheirLine) {
             std::string::npos);
   EXPECT_NE(msg("t.yaml", "kind: error_model\ntraining_fraction: 1.5\nchannels: {E: []}\n").find("(0, 1]"), std::string::npos);
   EXPECT_NE(msg("u.yaml", "kind: error_model\nchannels: {E: []}\nextra: 1\n").find("extra"), std::string::npos);
+  EXPECT_NE(msg("l.yaml", "kind: error_model\nchannels:\n  E: [{effect: transient, input: tool_changes, lever: travel_mm}]\n")
+                .find("only a static or lag effect acts over a lever"),
+            std::string::npos);
 }
