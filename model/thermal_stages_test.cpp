@@ -32,6 +32,20 @@ json part(const char* id, double S, const double F[4], double c, double a, doubl
 
 const double kF100[4] = {100, 100, 100, 100};
 
+// What a prediction reads besides the separation: k per axis (u 0.01), the travels and sizes
+// (steps 30, 45, 60, 75 mm; tool d 10, stylus d 2).
+json predictable(json j, double kx, double ky, double kz) {
+  j["k_pos_x_um_per_mm"] = budget(kx, 0.01);
+  j["k_pos_y_um_per_mm"] = budget(ky, 0.01);
+  j["k_pos_z_um_per_mm"] = budget(kz, 0.01);
+  for (int i = 0; i < 4; ++i) {
+    j["separation"][i]["travel_probe_mm"] = 32 + 15 * i;
+    j["separation"][i]["travel_tool_mm"] = 40 + 15 * i;
+    j["cmm"]["steps"].push_back({{"step", i + 1}, {"size_mm", 30 + 15 * i}});
+  }
+  return j;
+}
+
 ThermalStages threeStages() {
   return thermalStagesFromEvaluations({{part("W6", 1000, kF100, 3.0, 0.006, 0.02), "w6.json"},
                                        {part("W1", 3500, kF100, 0.8, 0.021, 0.07), "w1.json"},
@@ -83,15 +97,7 @@ TEST(ThermalStages, TheProcessPartLosesItsThermalError) {
     EXPECT_NEAR(steps[i].u_e_proc_x_um, std::hypot(0.5, 0.5), 1e-9);
   }
   // The prediction from the campaign: width = k L + e_proc(F) + e_pt(T, S).
-  json w8 = part("W8", 3500, F, 0.8, 0.021, 0.07, 0.008);
-  w8["k_pos_x_um_per_mm"] = budget(0.15, 0.01);
-  w8["k_pos_y_um_per_mm"] = budget(0.25, 0.01);
-  w8["k_pos_z_um_per_mm"] = budget(0.02, 0.01);
-  for (int i = 0; i < 4; ++i) {
-    w8["separation"][i]["travel_probe_mm"] = 32 + 15 * i;
-    w8["separation"][i]["travel_tool_mm"] = 40 + 15 * i;
-    w8["cmm"]["steps"].push_back({{"step", i + 1}, {"size_mm", 30 + 15 * i}});
-  }
+  const json w8 = predictable(part("W8", 3500, F, 0.8, 0.021, 0.07, 0.008), 0.15, 0.25, 0.02);
   const auto p = steppedPredictorFromCampaign(st, w8, "w8.json");
   const auto r = predictSteppedErrors(p, {{1, 60, 25, 300, 4500, 150}});
   ASSERT_EQ(r.size(), 1u);
@@ -115,15 +121,7 @@ TEST(ThermalStages, TheCampaignsProcessErrorFollowsTheChipLoad) {
                                                 {part("W1", 3500, kF100, c(100, 3500), 0.021, 0.07), "w1.json"},
                                                 {part("W7", 5500, kF100, c(100, 5500), 0.033, 0.11), "w7.json"}});
   const double F[4] = {100, 200, 400, 800};
-  json w8 = part("W8", 3500, F, 0, 0.021, 0.07, 0.03 / 3.5);
-  w8["k_pos_x_um_per_mm"] = budget(0, 0.01);
-  w8["k_pos_y_um_per_mm"] = budget(0, 0.01);
-  w8["k_pos_z_um_per_mm"] = budget(0, 0.01);
-  for (int i = 0; i < 4; ++i) {
-    w8["separation"][i]["travel_probe_mm"] = 32 + 15 * i;
-    w8["separation"][i]["travel_tool_mm"] = 40 + 15 * i;
-    w8["cmm"]["steps"].push_back({{"step", i + 1}, {"size_mm", 30 + 15 * i}});
-  }
+  const json w8 = predictable(part("W8", 3500, F, 0, 0.021, 0.07, 0.03 / 3.5), 0, 0, 0);
   const auto p = steppedPredictorFromCampaign(st, w8, "w8.json");
   EXPECT_NEAR(p.proc_x.at(200), 6.0, 1e-6);
   const auto r = predictSteppedErrors(p, {{1, 60, 25, 200, 1000, 0}});
