@@ -1,6 +1,7 @@
 #include "cli/model_commands.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -187,6 +188,7 @@ int runSeries(const ModelArgs& a) {
   std::vector<model::SteppedSeriesPart> parts;
   for (std::size_t i = 0; i + 1 < a.series_parts.size(); i += 2)
     parts.push_back({readJsonFile(a.series_parts[i]), a.series_parts[i], model::loadInputs(a.series_parts[i + 1])});
+  if (!std::isfinite(a.gap_h) || a.gap_h < 0) throw InputError("", 0, "model series: --gap-h must be a finite number of hours >= 0");
   const auto s = model::buildSteppedSeries(parts, a.gap_h * 3600.0);
   fs::create_directories(a.out);
   writeFileAtomic((fs::path(a.out) / "inputs.csv").string(), s.inputs_csv);

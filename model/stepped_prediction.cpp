@@ -77,7 +77,7 @@ double SteppedComponent::at(double v) const {
   return fit.function.evaluate(v);
 }
 
-SteppedPredictor steppedPredictorFromEvaluation(const json& e, const std::string& file) {
+SteppedPredictor steppedPredictorBase(const json& e, const std::string& file) {
   requireSteppedEvaluation(e, file);
   SteppedPredictor p;
   p.file = file;
@@ -90,6 +90,17 @@ SteppedPredictor steppedPredictorFromEvaluation(const json& e, const std::string
     p.k_um_per_mm[a] = v;
     p.u_k_um_per_mm[a] = u;
   }
+  // The tool's diameter: the tool centre's travel minus the size (cmm.steps[].size_mm).
+  const auto& cs = e.contains("cmm") ? e.at("cmm").value("steps", json::array()) : json::array();
+  if (cs.empty()) throw InputError(file, 0, "cmm.steps: missing (the sizes of the steps)");
+  p.tool_d_mm = evaluationNumber(seps[0], "travel_tool_mm", "separation[0].", file) - evaluationNumber(cs[0], "size_mm", "cmm.steps[0].", file);
+  p.probe_d_mm = evaluationNumber(seps[0], "travel_probe_mm", "separation[0].", file) - evaluationNumber(cs[0], "size_mm", "cmm.steps[0].", file);
+  return p;
+}
+
+SteppedPredictor steppedPredictorFromEvaluation(const json& e, const std::string& file) {
+  SteppedPredictor p = steppedPredictorBase(e, file);
+  const auto& seps = e.at("separation");
   std::vector<double> F, T{0.0}, px, py, ux, uy, splz{0.0}, us{0.0};
   double speed = -1;
   for (std::size_t i = 0; i < seps.size(); ++i) {
@@ -110,11 +121,6 @@ SteppedPredictor steppedPredictorFromEvaluation(const json& e, const std::string
     splz.push_back(bz.first);
     us.push_back(bz.second);
   }
-  // The tool's diameter: the tool centre's travel minus the size (cmm.steps[].size_mm).
-  const auto& cs = e.contains("cmm") ? e.at("cmm").value("steps", json::array()) : json::array();
-  if (cs.empty()) throw InputError(file, 0, "cmm.steps: missing (the sizes of the steps)");
-  p.tool_d_mm = evaluationNumber(seps[0], "travel_tool_mm", "separation[0].", file) - evaluationNumber(cs[0], "size_mm", "cmm.steps[0].", file);
-  p.probe_d_mm = evaluationNumber(seps[0], "travel_probe_mm", "separation[0].", file) - evaluationNumber(cs[0], "size_mm", "cmm.steps[0].", file);
   p.speed_ref_rpm = speed;
   const std::vector<Candidate> feed_forms{{Family::Polynomial, 1, true}, {Family::Polynomial, 2, true}, {Family::Hyperbolic, 0, false}};
   const std::vector<Candidate> time_forms{{Family::SaturatingExponential, 0, false},
@@ -170,7 +176,9 @@ std::string steppedComponentSummary(const SteppedComponent& c) {
 }
 
 std::string steppedPredictorSummary(const SteppedPredictor& p) {
-  std::string s = "Predicted from " + p.file + " (" + p.experiment + ", " + formatNumber(p.speed_ref_rpm) + " rpm): e_pos = k L with k_x " +
+  const std::string cond = p.thermal ? " (" + p.experiment + ", with the campaign's stages)"
+                                     : " (" + p.experiment + ", " + formatNumber(p.speed_ref_rpm) + " rpm)";
+  std::string s = "Predicted from " + p.file + cond + ": e_pos = k L with k_x " +
                   formatNumber(p.k_um_per_mm[0], 4) + ", k_y " + formatNumber(p.k_um_per_mm[1], 4) + ", k_z " +
                   formatNumber(p.k_um_per_mm[2], 4) + " um/mm\n";
   for (const auto* c : {&p.proc_x, &p.proc_y, &p.splz}) {

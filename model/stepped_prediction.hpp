@@ -66,6 +66,10 @@ struct SteppedPredictor {
 SteppedComponent fitSteppedComponent(std::string name, std::string variable, std::vector<double> x, std::vector<double> y,
                                      std::vector<double> u, const std::vector<Candidate>& candidates, const std::string& file);
 
+// What every predictor reads of an evaluation: the file, the experiment, k and u(k) per axis,
+// the tool's and the stylus's diameters (travels minus sizes); no component fitted.
+SteppedPredictor steppedPredictorBase(const nlohmann::json& evaluation, const std::string& file);
+
 SteppedPredictor steppedPredictorFromEvaluation(const nlohmann::json& evaluation, const std::string& file);
 
 struct SteppedConditions {

@@ -92,6 +92,19 @@ SteppedSeries buildSteppedSeries(const std::vector<SteppedSeriesPart>& parts, do
       r.width_x = evaluationNumber(g, "width_x_error_um", gw, file);
       r.width_y = evaluationNumber(g, "width_y_error_um", gw, file);
       r.depth = evaluationNumber(g, "depth_error_um", gw, file);
+      // A compensated part was cut off nominal on purpose (walls in, floors up): the machine's
+      // error is the CMM's plus the offsets (evaluation.json's compensation_applied).
+      if (part.evaluation.contains("compensation_applied")) {
+        const auto& ca = part.evaluation.at("compensation_applied");
+        if (!ca.is_array() || ca.size() != seps.size())
+          throw InputError(file, 0, "compensation_applied: one entry per step expected");
+        const std::string cw = "compensation_applied[" + std::to_string(i) + "].";
+        if (!ca[i].contains("wall_um")) throw InputError(file, 0, cw + "wall_um: missing");
+        const auto& w = ca[i].at("wall_um");
+        r.width_x += evaluationNumber(w, "XP", cw + "wall_um.", file) + evaluationNumber(w, "XN", cw + "wall_um.", file);
+        r.width_y += evaluationNumber(w, "YP", cw + "wall_um.", file) + evaluationNumber(w, "YN", cw + "wall_um.", file);
+        r.depth += evaluationNumber(ca[i], "floor_um", cw, file);
+      }
       r.U_x = 2 * evaluationNumber(s, "u_cmm_width_x_um", where, file);
       r.U_y = 2 * evaluationNumber(s, "u_cmm_width_y_um", where, file);
       r.U_z = 2 * evaluationNumber(s, "u_cmm_depth_um", where, file);
@@ -118,7 +131,7 @@ SteppedSeries buildSteppedSeries(const std::vector<SteppedSeriesPart>& parts, do
   std::ostringstream in;
   in << "time_s";
   for (const auto& n : names) in << "," << n;
-  in << ",travel_mm,depth_mm,cut_feed_mm_per_min,feed_per_rev_um\n";
+  in << ",travel_mm,depth_mm,cut_feed_mm_per_min,chip_load_um_per_rev\n";
   std::size_t c = 0;
   for (std::size_t k = 0; k < t_all.size(); ++k) {
     while (c + 1 < conds.size() && conds[c + 1].start_s <= t_all[k]) ++c;

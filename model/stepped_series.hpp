@@ -5,18 +5,20 @@
 // errors.csv: one row per step of each part at the mid-time of its wall cuts (evaluation.json's
 // cut_mid_s), channels the CMM's errors width_x_um, width_y_um, depth_um, U = 2 u of the CMM's
 // measurement (separation[].u_cmm_…: its MPE at the length, its planes' residuals, the part's
-// temperature at the CMM).
+// temperature at the CMM); a compensated part's rows add its offsets back (compensation_applied:
+// the walls' sum per width, the floor's for the depth), so that every row is the machine's error.
 // inputs.csv: the parts' logged inputs one after the other, each part shifted to start
 // `gap_s` after the previous one's last sample (the machine stood between the experiments,
 // which the thesis cut on different days): in the gap the speeds, the fluid and the tool
 // changes are 0 and every other column (temperatures) goes linearly from its last value to
 // the next part's first. Derived columns, the conditions of the step being cut (held from one
-// step's start to the next's, so that a mid-cut sample reads its own step's):
+// step's start to the next's, through the gaps too: they are for static effects, read at the
+// rows, each its own step's; their names are not speeds, so the diagnosis offers no lag of them):
 //   travel_mm              size + tool d: the tool centre's travel between opposite walls
 //                          (a position error proportional to the distance reads it);
 //   depth_mm               the floor's nominal depth below the top;
 //   cut_feed_mm_per_min    the step's XY feed (the thesis's process variable);
-//   feed_per_rev_um        the feed per spindle revolution, 1000 F / S (the chip load);
+//   chip_load_um_per_rev   the feed per spindle revolution, 1000 F / S (the chip load);
 // model.yaml: the starting model "position error only": static(travel_mm) for the widths,
 // static(depth_mm) for the depth, trained on the first 60 % of the rows.
 //

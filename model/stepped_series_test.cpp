@@ -55,7 +55,7 @@ TEST(SteppedSeries, TwoPartsOnOneClockWithTheGapBetween) {
   // Part 1: 11 samples 0..100 s; the gap: 6 samples 110..160 s; part 2: 11 samples from 170 s.
   ASSERT_EQ(in.rows.size(), 28u);
   const int t = in.column("time_s"), T = in.column("T_env_C"), S = in.column("spindle_rpm"), tc = in.column("tool_changes"),
-            L = in.column("travel_mm"), f = in.column("feed_per_rev_um"), F = in.column("cut_feed_mm_per_min");
+            L = in.column("travel_mm"), f = in.column("chip_load_um_per_rev"), F = in.column("cut_feed_mm_per_min");
   EXPECT_DOUBLE_EQ(in.number(in.rows[17], t), 170);
   // In the gap the spindle stands and the hall goes linearly from 21 C (part 1's last) to 22 C.
   EXPECT_DOUBLE_EQ(in.number(in.rows[11], S), 0);
@@ -78,6 +78,19 @@ TEST(SteppedSeries, TwoPartsOnOneClockWithTheGapBetween) {
   EXPECT_DOUBLE_EQ(er.number(er.rows[3], wx), 4);
   EXPECT_DOUBLE_EQ(er.number(er.rows[1], U), 2.2);
   EXPECT_NE(s.model_yaml.find("width_x_um: [{effect: static, input: travel_mm}]"), std::string::npos);
+}
+
+// A compensated part was cut off nominal on purpose: its rows are the CMM's error plus the
+// offsets (walls XP + XN = 1.5 + 1.5 um, YP + YN = 2 + 2, floor 0.7).
+TEST(SteppedSeries, ACompensatedPartsRowsAddItsOffsetsBack) {
+  auto e = evaluation("W8", 200);
+  for (int i = 0; i < 2; ++i)
+    e["compensation_applied"].push_back({{"step", i + 1}, {"wall_um", {{"XP", 1.5}, {"XN", 1.5}, {"YP", 2.0}, {"YN", 2.0}}}, {"floor_um", 0.7}});
+  const auto s = buildSteppedSeries({{e, "w8.json", log("w8.csv", 20)}});
+  const auto er = parseCsv(s.errors_csv, "errors.csv");
+  EXPECT_DOUBLE_EQ(er.number(er.rows[1], er.column("width_x_um")), 4 + 3);
+  EXPECT_DOUBLE_EQ(er.number(er.rows[1], er.column("width_y_um")), 6 + 4);
+  EXPECT_DOUBLE_EQ(er.number(er.rows[1], er.column("depth_um")), -2 + 0.7);
 }
 
 TEST(SteppedSeries, RefusesPartsThatAreNotOneCampaign) {

@@ -34,12 +34,17 @@ const std::vector<Candidate>& splzForms() {
 
 // A form is a candidate only when it leaves two degrees of freedom: a 3-parameter curve through
 // a stage's 4 steps leaves one, and its leave-one-out fits are exact (Student's t 12.7).
-std::vector<Candidate> leavingTwoDof(const std::vector<Candidate>& forms, std::size_t n) {
+std::vector<Candidate> leavingTwoDof(const std::vector<Candidate>& forms, std::size_t n, const std::string& what) {
   std::vector<Candidate> out;
+  std::size_t fewest = 99;
   for (const auto& c : forms) {
     const std::size_t p = parameterNames(c.family, c.degree).size() - (c.through_origin ? 1 : 0);
+    fewest = std::min(fewest, p);
     if (p + 2 <= n) out.push_back(c);
   }
+  if (out.empty())
+    throw GeometryError(what + ": " + std::to_string(n) + " points; the simplest form has " + std::to_string(fewest) +
+                        " parameters and must leave 2 degrees of freedom: at least " + std::to_string(fewest + 2) + " points");
   return out;
 }
 
@@ -140,8 +145,10 @@ ThermalStages thermalStagesFromEvaluations(const std::vector<std::pair<json, std
     s.spindle_rpm = static_cast<double>(key);
     s.feed_mm_per_min = feed_of[key];
     const std::string label = "stage " + rpm(s.spindle_rpm);
-    if (pts.size() < 3)
-      throw GeometryError(label + ": " + std::to_string(pts.size()) + " steps; a thermal curve needs at least 3");
+    if (!(s.spindle_rpm > 0)) throw GeometryError(label + ": a thermal stage is cut with the spindle turning");
+    if (pts.size() < 4)
+      throw GeometryError(label + ": " + std::to_string(pts.size()) + " steps; a thermal curve with a free intercept needs at least 4 "
+                                  "(a line leaves 2 degrees of freedom)");
     std::vector<double> T, px, ux, py, uy, sT{0.0}, sz{0.0}, su{0.0};
     for (const auto& p : pts) {
       if (std::find(s.files.begin(), s.files.end(), p.file) == s.files.end()) {
@@ -149,6 +156,7 @@ ThermalStages thermalStagesFromEvaluations(const std::vector<std::pair<json, std
         s.experiments.push_back(p.experiment);
       }
       s.steps.push_back(p.step);
+      s.point_experiments.push_back(p.experiment);
       T.push_back(p.T);
       px.push_back(p.px);
       ux.push_back(p.ux);
@@ -158,9 +166,9 @@ ThermalStages thermalStagesFromEvaluations(const std::vector<std::pair<json, std
       sz.push_back(p.splz);
       su.push_back(p.us);
     }
-    s.one_part_x = fitSteppedComponent("e_pt_x_um", "temp_state_min", T, px, ux, leavingTwoDof(ptForms(), T.size()), label);
-    s.one_part_y = fitSteppedComponent("e_pt_y_um", "temp_state_min", T, py, uy, leavingTwoDof(ptForms(), T.size()), label);
-    s.splz = fitSteppedComponent("e_splz_um", "temp_state_min", sT, sz, su, leavingTwoDof(splzForms(), sT.size()), label);
+    s.one_part_x = fitSteppedComponent("e_pt_x_um", "temp_state_min", T, px, ux, leavingTwoDof(ptForms(), T.size(), label + " e_pt_x"), label);
+    s.one_part_y = fitSteppedComponent("e_pt_y_um", "temp_state_min", T, py, uy, leavingTwoDof(ptForms(), T.size(), label + " e_pt_y"), label);
+    s.splz = fitSteppedComponent("e_splz_um", "temp_state_min", sT, sz, su, leavingTwoDof(splzForms(), sT.size(), label + " e_splz"), label);
     st.stages.push_back(std::move(s));
   }
   if (st.stages.empty()) throw GeometryError("thermal stages: no part given");
@@ -175,6 +183,7 @@ std::vector<ProcessStep> separateProcess(const ThermalStages& st, const json& e,
     const auto& s = seps[i];
     const std::string where = "separation[" + std::to_string(i) + "].";
     ProcessStep p;
+    p.experiment = e.value("experiment", "");
     p.step = s.value("step", static_cast<int>(i) + 1);
     p.feed_mm_per_min = evaluationNumber(s, "feed_mm_per_min", where, file);
     p.spindle_rpm = evaluationNumber(s, "spindle_rpm", where, file);
@@ -195,7 +204,9 @@ std::vector<ProcessStep> separateProcess(const ThermalStages& st, const json& e,
 }
 
 SteppedPredictor steppedPredictorFromCampaign(const ThermalStages& st, const json& process, const std::string& file) {
-  SteppedPredictor p = steppedPredictorFromEvaluation(process, file);
+  // The process part may change its speed from step to step (the chip load is its variable): only
+  // k and the diameters are read from it, its e_splz is the stages'.
+  SteppedPredictor p = steppedPredictorBase(process, file);
   // e_proc(F) refitted to the process part's steps with the thermal error taken out.
   // The process error against the feed per revolution (the chip load, 1000 F / S): the process
   // part's steps with e_pt taken out, and each stage's intercept, its process error at its own
@@ -299,7 +310,7 @@ std::string separationJson(const ThermalStages& st, const std::vector<ProcessSte
   return j.dump(2) + "\n";
 }
 
-Campaign campaignFromSeparationJson(const json& j, const std::string& file) {
+SeparationCampaign campaignFromSeparationJson(const json& j, const std::string& file) {
   if (!j.is_object() || j.value("kind", "") != "stepped_separation" || !j.contains("stage_evaluations") ||
       !j.at("stage_evaluations").is_array())
     throw InputError(file, 0, "kind: expected the separation.json of `probeloop separate` (stepped workpiece campaign)");
@@ -308,7 +319,7 @@ Campaign campaignFromSeparationJson(const json& j, const std::string& file) {
     if (!s.is_object() || !s.contains("evaluation")) throw InputError(file, 0, "stage_evaluations[]: expected {file, evaluation}");
     parts.emplace_back(s.at("evaluation"), file + ": stage_evaluations[" + s.value("file", "?") + "]");
   }
-  Campaign c;
+  SeparationCampaign c;
   c.stages = thermalStagesFromEvaluations(parts);
   if (j.contains("process_evaluation")) {
     c.process_evaluation = j.at("process_evaluation");
@@ -327,7 +338,7 @@ std::string separationCsv(const ThermalStages& st, const std::vector<ProcessStep
       const auto x = st.at(ThermalComponent::PtX, T, g.spindle_rpm), y = st.at(ThermalComponent::PtY, T, g.spindle_rpm),
                  z = st.at(ThermalComponent::Splz, T, g.spindle_rpm);
       // The stage's own process (and control) error: its intercept (L844).
-      s += "stage,," + std::to_string(g.steps[i]) + "," + f(g.spindle_rpm) + "," + f(g.feed_mm_per_min) + "," + f(T) + "," +
+      s += "stage," + g.point_experiments[i] + "," + std::to_string(g.steps[i]) + "," + f(g.spindle_rpm) + "," + f(g.feed_mm_per_min) + "," + f(T) + "," +
            f(g.one_part_x.y[i]) + "," + f(g.one_part_y.y[i]) + "," + f(x.value_um) + "," + f(x.k95 * x.u_um) + "," + f(y.value_um) + "," +
            f(y.k95 * y.u_um) + "," + f(z.value_um) + "," + f(z.k95 * z.u_um) + "," + f(g.intercept_x_um()) + "," +
            f(g.one_part_x.k95 * g.one_part_x.u_pred_um) + "," + f(g.intercept_y_um()) + "," + f(g.one_part_y.k95 * g.one_part_y.u_pred_um) + "\n";
@@ -335,7 +346,7 @@ std::string separationCsv(const ThermalStages& st, const std::vector<ProcessStep
   }
   for (const auto& p : process) {
     const auto z = st.at(ThermalComponent::Splz, p.temp_state_min, p.spindle_rpm);
-    s += "process,," + std::to_string(p.step) + "," + f(p.spindle_rpm) + "," + f(p.feed_mm_per_min) + "," + f(p.temp_state_min) + "," +
+    s += "process," + p.experiment + "," + std::to_string(p.step) + "," + f(p.spindle_rpm) + "," + f(p.feed_mm_per_min) + "," + f(p.temp_state_min) + "," +
          f(p.one_part_x_um) + "," + f(p.one_part_y_um) + "," + f(p.pt_x.value_um) + "," + f(p.pt_x.k95 * p.pt_x.u_um) + "," +
          f(p.pt_y.value_um) + "," + f(p.pt_y.k95 * p.pt_y.u_um) + "," + f(z.value_um) + "," + f(z.k95 * z.u_um) + "," + f(p.e_proc_x_um) +
          "," + f(p.U_e_proc_x_um) + "," + f(p.e_proc_y_um) + "," + f(p.U_e_proc_y_um) + "\n";

@@ -26,8 +26,9 @@
 // the distance; docs/stepped-workpiece.md §8 states the limit).
 //
 // Contract: InputError naming the file: not a stepped evaluation; a stage part whose feed or
-// speed changes between steps; GeometryError: no stage, a stage with fewer than 3 steps, no form
-// that fits, a Temp state beyond twice a stage's largest.
+// speed changes between steps; GeometryError: no stage, a stage at 0 rpm or with fewer than 4
+// steps (a line with a free intercept must leave 2 dof), no form that fits, a Temp state beyond
+// twice a stage's largest.
 #pragma once
 #include <nlohmann/json.hpp>
 #include <string>
@@ -41,6 +42,7 @@ struct ThermalStage {
   double spindle_rpm = 0, feed_mm_per_min = 0;
   std::vector<std::string> experiments, files;
   std::vector<int> steps;     // per point: the step it came from
+  std::vector<std::string> point_experiments;  // per point: its part's experiment
   SteppedComponent one_part_x, one_part_y;  // the one-part e_proc against T, with the intercept
   SteppedComponent splz;
   double intercept_x_um() const { return one_part_x.fit.function.evaluate(0); }
@@ -68,6 +70,7 @@ ThermalStages thermalStagesFromEvaluations(const std::vector<std::pair<nlohmann:
 // A part cut at changing feeds (W8) with the stages' thermal error taken out of each step's
 // one-part e_proc (L868, L1629): e_proc = one-part e_proc - e_pt(T, S).
 struct ProcessStep {
+  std::string experiment;
   int step = 0;
   double feed_mm_per_min = 0, spindle_rpm = 0, temp_state_min = 0;
   double one_part_x_um = 0, u_one_part_x_um = 0, one_part_y_um = 0, u_one_part_y_um = 0;
@@ -91,11 +94,11 @@ std::string separationJson(const ThermalStages& st, const std::vector<ProcessSte
                            const nlohmann::json* process_evaluation, const std::string& process_file);
 std::string separationCsv(const ThermalStages& st, const std::vector<ProcessStep>& process);
 std::string separationSummary(const ThermalStages& st, const std::vector<ProcessStep>& process);
-struct Campaign {
+struct SeparationCampaign {
   ThermalStages stages;
   nlohmann::json process_evaluation;  // null when the campaign had no process part
   std::string process_file;
 };
-Campaign campaignFromSeparationJson(const nlohmann::json& j, const std::string& file);
+SeparationCampaign campaignFromSeparationJson(const nlohmann::json& j, const std::string& file);
 
 }  // namespace probeloop::model

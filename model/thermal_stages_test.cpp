@@ -124,6 +124,11 @@ TEST(ThermalStages, TheCampaignsProcessErrorFollowsTheChipLoad) {
   const json w8 = predictable(part("W8", 3500, F, 0, 0.021, 0.07, 0.03 / 3.5), 0, 0, 0);
   const auto p = steppedPredictorFromCampaign(st, w8, "w8.json");
   EXPECT_NEAR(p.proc_x.at(200), 6.0, 1e-6);
+  // A process part that changes its speed between steps (as W3 does) is a campaign's too.
+  json w3 = w8;
+  w3["separation"][2]["spindle_rpm"] = 1000;
+  EXPECT_NO_THROW(steppedPredictorFromCampaign(st, w3, "w3.json"));
+  EXPECT_THROW(steppedPredictorFromEvaluation(w3, "w3.json"), InputError);
   const auto r = predictSteppedErrors(p, {{1, 60, 25, 200, 1000, 0}});
   EXPECT_NEAR(r[0].width_x_um, 6.0, 1e-6);  // k = 0, T = 0: e_pt 0
 }
@@ -149,6 +154,15 @@ TEST(ThermalStages, RefusesWhatIsNotAStage) {
   ASSERT_EQ(pooled.stages.size(), 1u);
   EXPECT_EQ(pooled.stages[0].one_part_x.x.size(), 8u);
   EXPECT_THROW(thermalStagesFromEvaluations({{json{{"kind", "thermal_test_piece"}}, "t.json"}}), InputError);
+  // Three steps leave a line with a free intercept 1 dof: refused with the reason.
+  auto three = part("W1", 3500, kF100, 0.8, 0.02, 0.07);
+  three["separation"].erase(3);
+  try {
+    thermalStagesFromEvaluations({{three, "w1.json"}});
+    FAIL() << "a 3-step stage was fitted";
+  } catch (const GeometryError& e) {
+    EXPECT_NE(std::string(e.what()).find("at least 4"), std::string::npos) << e.what();
+  }
   EXPECT_THROW(threeStages().at(ThermalComponent::PtX, 400, 3500), GeometryError);  // T beyond 2 x 186
 }
 

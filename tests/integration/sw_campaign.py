@@ -155,7 +155,7 @@ for rnd in range(1, 5):
 check(f"the loop added the thermal scale on the widths, the spindle's growth on the depth and a feed term on the widths: {added}",
       ("lag(spindle_rpm)*travel_mm", "width_x_um") in added and ("lag(spindle_rpm)*travel_mm", "width_y_um") in added
       and ("lag(spindle_rpm)", "depth_um") in added
-      and any(i.startswith("static(feed") or i.startswith("static(cut_feed") for i, c in added if c.startswith("width")))
+      and any(i.split("(")[0] == "static" and ("feed" in i or "chip_load" in i) for i, c in added if c.startswith("width")))
 rmse_end, fitj = fit_rmse()
 for ch in ("width_x_um", "width_y_um", "depth_um"):
     check(f"{ch}: validation RMSE {rmse0[ch]:.2f} (position only) -> {rmse_end[ch]:.2f} um (40 % or less)",
