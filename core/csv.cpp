@@ -85,6 +85,12 @@ CsvTable parseCsv(const std::string& text, const std::string& file_name) {
   return t;
 }
 
+std::string formatSignificant4(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", v);
+  return buf;
+}
+
 std::string formatNumber(double v, int decimals) {
   char buf[64];
   if (decimals >= 0) {

@@ -29,5 +29,7 @@ CsvTable parseCsv(const std::string& text, const std::string& file_name);
 
 // Shortest round-trip decimal of a double ("%.17g" trimmed), for deterministic output.
 std::string formatNumber(double v, int decimals = -1);
+// Four significant digits ("%.4g"), for reports whose numbers span orders of magnitude.
+std::string formatSignificant4(double v);
 
 }  // namespace probeloop

@@ -13,11 +13,7 @@ using uncertainty::Contribution;
 
 namespace {
 
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", v);
-  return b;
-}
+std::string num(double v) { return formatSignificant4(v); }
 
 // Standard deviation of W_j . centres when every point has standard deviation sigma.
 double throughFit(const Eigen::MatrixXd& W, int j, const CycleBudgetInput& c, double sigma_mm) {

@@ -41,11 +41,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // second-order terms at 1 um are ~1e-8 relative.
 constexpr double kFrameStepMm = 1e-3;
 
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", v);
-  return b;
-}
+std::string num(double v) { return formatSignificant4(v); }
 
 std::string lineList(const std::vector<int>& lines) {
   std::string s;

@@ -1,7 +1,6 @@
 #include "model/stepped_prediction.hpp"
 
 #include <cmath>
-#include <cstdio>
 
 #include "core/csv.hpp"
 #include "core/error.hpp"
@@ -11,17 +10,6 @@
 namespace probeloop::model {
 
 using nlohmann::json;
-
-namespace {
-
-// Four significant digits (the fitted parameters span 1e-6 to 1e2).
-std::string sig4(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", v);
-  return b;
-}
-
-}  // namespace
 
 SteppedComponent fitSteppedComponent(std::string name, std::string variable, std::vector<double> x, std::vector<double> y,
                                      std::vector<double> u, const std::vector<Candidate>& candidates, const std::string& file) {
@@ -169,7 +157,7 @@ std::string steppedComponentSummary(const SteppedComponent& c) {
   const auto& best = c.selection.candidates[static_cast<std::size_t>(c.selection.best)];
   std::string params;
   for (std::size_t i = 0; i < c.fit.function.p.size(); ++i)
-    params += (i ? ", " : "") + (i < c.fit.names.size() ? c.fit.names[i] : "p" + std::to_string(i)) + " " + sig4(c.fit.function.p[i]);
+    params += (i ? ", " : "") + (i < c.fit.names.size() ? c.fit.names[i] : "p" + std::to_string(i)) + " " + formatSignificant4(c.fit.function.p[i]);
   return c.name + "(" + c.variable + "): " + best.candidate.label() + " [" + params + "], the best of " +
          std::to_string(c.selection.candidates.size()) + " forms by leave-one-out (RMS " + formatNumber(best.loo_rms, 3) + " um over " +
          std::to_string(c.x.size()) + " points); u " + formatNumber(c.u_pred_um, 3) + " um";

@@ -26,7 +26,6 @@ struct StepCondition {
 
 bool isEventOrSwitch(const std::string& c) { return c == "tool_changes" || c == "mwf_on"; }
 
-std::string num(double v, int d) { return formatNumber(v, d); }
 
 }  // namespace
 
@@ -120,7 +119,7 @@ SteppedSeries buildSteppedSeries(const std::vector<SteppedSeriesPart>& parts, do
       conds.push_back(c);
     }
     comment << "# part " << p + 1 << ": " << file << " (" << part.evaluation.value("experiment", "?") << "), inputs " << in.file
-            << " shifted by " << num(offset, 1) << " s\n";
+            << " shifted by " << formatNumber(offset, 1) << " s\n";
   }
   // Rows must be in time order (parts in the given order, steps in cut order).
   for (std::size_t i = 1; i < rows.size(); ++i)
@@ -135,10 +134,10 @@ SteppedSeries buildSteppedSeries(const std::vector<SteppedSeriesPart>& parts, do
   std::size_t c = 0;
   for (std::size_t k = 0; k < t_all.size(); ++k) {
     while (c + 1 < conds.size() && conds[c + 1].start_s <= t_all[k]) ++c;
-    in << num(t_all[k], 3);
-    for (const auto& col : cols) in << "," << num(col[k], 4);
+    in << formatNumber(t_all[k], 3);
+    for (const auto& col : cols) in << "," << formatNumber(col[k], 4);
     const auto& s = conds[c];
-    in << "," << num(s.travel, 3) << "," << num(s.depth, 3) << "," << num(s.feed, 1) << "," << num(s.feed_per_rev, 4) << "\n";
+    in << "," << formatNumber(s.travel, 3) << "," << formatNumber(s.depth, 3) << "," << formatNumber(s.feed, 1) << "," << formatNumber(s.feed_per_rev, 4) << "\n";
   }
   out.inputs_csv = in.str();
   std::ostringstream er;
@@ -146,8 +145,8 @@ SteppedSeries buildSteppedSeries(const std::vector<SteppedSeriesPart>& parts, do
   er << "time_s,cycle,width_x_um,width_y_um,depth_um,U_width_x_um,U_width_y_um,U_depth_um\n";
   for (std::size_t i = 0; i < rows.size(); ++i) {
     const auto& r = rows[i];
-    er << num(r.t_s, 3) << "," << i + 1 << "," << num(r.width_x, 4) << "," << num(r.width_y, 4) << "," << num(r.depth, 4) << ","
-       << num(r.U_x, 4) << "," << num(r.U_y, 4) << "," << num(r.U_z, 4) << "\n";
+    er << formatNumber(r.t_s, 3) << "," << i + 1 << "," << formatNumber(r.width_x, 4) << "," << formatNumber(r.width_y, 4) << "," << formatNumber(r.depth, 4) << ","
+       << formatNumber(r.U_x, 4) << "," << formatNumber(r.U_y, 4) << "," << formatNumber(r.U_z, 4) << "\n";
   }
   out.errors_csv = er.str();
   out.model_yaml =

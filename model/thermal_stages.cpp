@@ -229,8 +229,8 @@ SteppedPredictor steppedPredictorFromCampaign(const ThermalStages& st, const jso
     uy.push_back(g.one_part_y.u_pred_um);
   }
   const std::vector<Candidate> feed_forms{{Family::Polynomial, 1, true}, {Family::Polynomial, 2, true}, {Family::Hyperbolic, 0, false}};
-  p.proc_x = fitSteppedComponent("e_proc_x_um", "feed_per_rev_um", f, px, ux, feed_forms, file);
-  p.proc_y = fitSteppedComponent("e_proc_y_um", "feed_per_rev_um", f, py, uy, feed_forms, file);
+  p.proc_x = fitSteppedComponent("e_proc_x_um", "chip_load_um_per_rev", f, px, ux, feed_forms, file);
+  p.proc_y = fitSteppedComponent("e_proc_y_um", "chip_load_um_per_rev", f, py, uy, feed_forms, file);
   p.proc_per_rev = true;
   p.thermal = [st](double T, double S) {
     ThermalTerms t;

@@ -104,7 +104,7 @@ TEST(ThermalStages, TheProcessPartLosesItsThermalError) {
   // e_proc against the feed per revolution (1000 F / S); only the thermal term is checked here:
   // at 4500 rpm halfway between 3500 and 5500.
   EXPECT_TRUE(p.proc_per_rev);
-  EXPECT_EQ(p.proc_x.variable, "feed_per_rev_um");
+  EXPECT_EQ(p.proc_x.variable, "chip_load_um_per_rev");
   const double pt = 0.5 * 0.021 * 150 + 0.5 * 0.033 * 150;
   EXPECT_NEAR(r[0].width_x_um - 0.15 * 70 - p.proc_x.at(1000.0 * 300 / 4500), pt, 1e-6);
   EXPECT_NEAR(r[0].depth_um, 0.02 * 25 - (0.5 * 0.07 + 0.5 * 0.11) * 150, 1e-6);

@@ -17,7 +17,7 @@ scales with the spindle's heat: the thermal position error e_pt) -> `probeloop s
 Needs $PROBELOOP and $PROBELOOP_SOURCE_DIR. Not run under the sanitizers (six simulated parts);
 the module's unit tests (model/thermal_stages_test.cpp) are.
 """
-import csv, json, math, os, subprocess, sys, tempfile
+import csv, json, math, os, re, subprocess, sys, tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks  # noqa: E402
@@ -166,7 +166,6 @@ truth_text = open(TRUTH).read()
 
 
 def node_tau_min(name):
-    import re
     m = re.search(rf"- name: {name}\s*\n\s*capacity_J_per_K: ([\d.e+]+)\s*\n\s*to_environment_W_per_K: ([\d.]+)", truth_text)
     return float(m.group(1)) / float(m.group(2)) / 60
 
