@@ -3,11 +3,13 @@
 #include <cstdio>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "cli/json_file.hpp"
 #include "core/atomic_file.hpp"
+#include "model/control_errors.hpp"
 #include "model/thermal_stages.hpp"
 
 namespace probeloop::cli {
@@ -15,7 +17,7 @@ namespace {
 
 struct SeparateArgs {
   std::vector<std::string> stages;
-  std::string process, out = "separation";
+  std::string process, control, force, out = "separation";
 };
 
 int run(const SeparateArgs& a) {
@@ -28,14 +30,25 @@ int run(const SeparateArgs& a) {
     pe = readJsonFile(a.process);
     process = model::separateProcess(st, pe, a.process);
   }
+  std::optional<model::ControlSeparation> control;
+  if (!a.control.empty() || !a.force.empty()) {
+    const nlohmann::json ce = a.control.empty() ? nlohmann::json() : readJsonFile(a.control);
+    const nlohmann::json fe = a.force.empty() ? nlohmann::json() : readJsonFile(a.force);
+    control = model::separateControl(st, pe, a.process, a.control.empty() ? nullptr : &ce, a.control,
+                                     a.force.empty() ? nullptr : &fe, a.force);
+  }
   // Everything computed before the first file is written.
-  const std::string json = model::separationJson(st, process, a.process.empty() ? nullptr : &pe, a.process);
+  const nlohmann::json cj = control ? model::controlJson(*control) : nlohmann::json();
+  const std::string json = model::separationJson(st, process, a.process.empty() ? nullptr : &pe, a.process, control ? &cj : nullptr);
   const std::string csv = model::separationCsv(st, process);
+  const std::string ccsv = control ? model::controlCsv(*control) : std::string();
   std::filesystem::create_directories(a.out);
   writeFileAtomic((std::filesystem::path(a.out) / "separation.json").string(), json);
   writeFileAtomic((std::filesystem::path(a.out) / "separation.csv").string(), csv);
+  if (control) writeFileAtomic((std::filesystem::path(a.out) / "control.csv").string(), ccsv);
   std::fputs(model::separationSummary(st, process).c_str(), stdout);
-  std::printf("  wrote separation.json, separation.csv in %s\n", a.out.c_str());
+  if (control) std::fputs(model::controlSummary(*control).c_str(), stdout);
+  std::printf("  wrote separation.json, separation.csv%s in %s\n", control ? ", control.csv" : "", a.out.c_str());
   return 0;
 }
 
@@ -49,6 +62,16 @@ std::function<int()> addSeparateCommand(CLI::App& app, CLI::App*& sub) {
   sub->add_option("--stage", a->stages, "evaluation.json of a thermal-stage part (repeat; parts at one speed are pooled)")
       ->required()->check(CLI::ExistingFile);
   sub->add_option("--process", a->process, "evaluation.json of the part cut at changing feeds (W8)")->check(CLI::ExistingFile);
+  sub->add_option("--control", a->control,
+                  "evaluation.json of a part whose walls are joined by fast transitions (W2): its control error e_ctrl "
+                  "against the process part (Eq. 3.11-3.14)")
+      ->check(CLI::ExistingFile);
+  sub->add_option("--force", a->force,
+                  "evaluation.json of a part cut as one continuous path (W5): its control error under the process force "
+                  "e_cpr against the process part (Eq. 3.15)")
+      ->check(CLI::ExistingFile);
+  sub->get_option("--control")->needs(sub->get_option("--process"));
+  sub->get_option("--force")->needs(sub->get_option("--process"));
   sub->add_option("--out", a->out, "output folder")->capture_default_str();
   return [a] { return run(*a); };
 }

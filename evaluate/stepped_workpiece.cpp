@@ -230,6 +230,8 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoi
     throw InputError(m.file, 0, "kind: '" + m.kind + "': the stepped-workpiece evaluation needs a stepped_workpiece plan");
   SwEvaluation e;
   e.experiment = m.sw.experiment;
+  e.transition = m.sw.transition;
+  e.transition_feed_mm_per_min = m.sw.transition_feed_mm_per_min;
   e.applied = m.sw.compensation;
   const auto rep = probeRepeatability(m, probe);
   const double mpe0 = m.sw.cmm.mpe_constant_um, mpeK = m.sw.cmm.mpe_length_mm;
@@ -492,6 +494,8 @@ std::string swEvaluationJson(const SwEvaluation& e) {
   j["format"] = "probeloop-evaluation";
   j["kind"] = "stepped_workpiece";
   j["experiment"] = e.experiment;
+  j["transition"] = e.transition;
+  if (e.transition != "continuous") j["transition_feed_mm_per_min"] = e.transition_feed_mm_per_min;
   auto geom = [](const SwSourceGeometry& g) {
     nlohmann::ordered_json s{{"file", g.file}, {"route", g.route}};
     for (const auto& p : g.planes)

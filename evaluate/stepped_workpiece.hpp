@@ -109,6 +109,10 @@ struct SwBeforeAfter {
 
 struct SwEvaluation {
   std::string experiment;
+  // How the walls were joined (the manifest's: non_cutting | fast | continuous) and at what feed
+  // (mm/min; a continuous path turns at each step's cutting feed): the control error's variable.
+  std::string transition;
+  double transition_feed_mm_per_min = 0;
   SwSourceGeometry cmm, probe;
   double probe_repeatability_um = 0;  // 1 sigma per point
   int probe_repeat_pairs = 0;         // 0: the manifest's specification was used

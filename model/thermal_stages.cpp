@@ -32,8 +32,17 @@ const std::vector<Candidate>& splzForms() {
   return f;
 }
 
-// A form is a candidate only when it leaves two degrees of freedom: a 3-parameter curve through
-// a stage's 4 steps leaves one, and its leave-one-out fits are exact (Student's t 12.7).
+double componentAt(const ThermalStage& s, ThermalComponent c, double T, double* u, double* k) {
+  const SteppedComponent& sc = c == ThermalComponent::PtX ? s.one_part_x : c == ThermalComponent::PtY ? s.one_part_y : s.splz;
+  *u = sc.u_pred_um;
+  *k = sc.k95;
+  return c == ThermalComponent::Splz ? sc.at(T) : sc.at(T) - sc.at(0);
+}
+
+std::string rpm(double S) { return formatNumber(S) + " rpm"; }
+
+}  // namespace
+
 std::vector<Candidate> leavingTwoDof(const std::vector<Candidate>& forms, std::size_t n, const std::string& what) {
   std::vector<Candidate> out;
   std::size_t fewest = 99;
@@ -47,17 +56,6 @@ std::vector<Candidate> leavingTwoDof(const std::vector<Candidate>& forms, std::s
                         " parameters and must leave 2 degrees of freedom: at least " + std::to_string(fewest + 2) + " points");
   return out;
 }
-
-double componentAt(const ThermalStage& s, ThermalComponent c, double T, double* u, double* k) {
-  const SteppedComponent& sc = c == ThermalComponent::PtX ? s.one_part_x : c == ThermalComponent::PtY ? s.one_part_y : s.splz;
-  *u = sc.u_pred_um;
-  *k = sc.k95;
-  return c == ThermalComponent::Splz ? sc.at(T) : sc.at(T) - sc.at(0);
-}
-
-std::string rpm(double S) { return formatNumber(S) + " rpm"; }
-
-}  // namespace
 
 ThermalValue ThermalStages::at(ThermalComponent c, double T, double S) const {
   if (stages.empty()) throw GeometryError("thermal stages: none (give the evaluations of parts cut at one feed and one speed)");
@@ -275,7 +273,7 @@ json valueJson(const ThermalValue& v) {
 }  // namespace
 
 std::string separationJson(const ThermalStages& st, const std::vector<ProcessStep>& process, const json* process_evaluation,
-                           const std::string& process_file) {
+                           const std::string& process_file, const json* control) {
   json j{{"kind", "stepped_separation"}};
   j["interpolation"] =
       "linear in the spindle speed between the stages, the weight (S - S_a)/(S_b - S_a) on the faster stage b; outside the "
@@ -302,6 +300,7 @@ std::string separationJson(const ThermalStages& st, const std::vector<ProcessSte
                   {"e_proc_y_um", {{"value", p.e_proc_y_um}, {"u_c", p.u_e_proc_y_um}, {"U", p.U_e_proc_y_um}}}});
   }
   j["process"] = ps;
+  if (control) j["control"] = *control;
   if (process_evaluation) {
     j["process_file"] = process_file;
     j["process_evaluation"] = *process_evaluation;

@@ -38,6 +38,11 @@
 
 namespace probeloop::model {
 
+// The forms that leave two degrees of freedom on n points (GeometryError naming `what` when none
+// does): a 3-parameter curve through 4 steps leaves one, and its leave-one-out fits are exact
+// (Student's t 12.7).
+std::vector<Candidate> leavingTwoDof(const std::vector<Candidate>& forms, std::size_t n, const std::string& what);
+
 struct ThermalStage {
   double spindle_rpm = 0, feed_mm_per_min = 0;
   std::vector<std::string> experiments, files;
@@ -90,8 +95,10 @@ SteppedPredictor steppedPredictorFromCampaign(const ThermalStages& st, const nlo
 // interpolation's weights stated, and the process part's evaluation.json embedded (so that
 // `plan --predict-from separation.json` refits the same campaign); read back by
 // campaignFromSeparationJson (InputError naming the file when it is not one).
+// `control`: the control errors' block (model/control_errors.hpp controlJson), or null.
 std::string separationJson(const ThermalStages& st, const std::vector<ProcessStep>& process,
-                           const nlohmann::json* process_evaluation, const std::string& process_file);
+                           const nlohmann::json* process_evaluation, const std::string& process_file,
+                           const nlohmann::json* control = nullptr);
 std::string separationCsv(const ThermalStages& st, const std::vector<ProcessStep>& process);
 std::string separationSummary(const ThermalStages& st, const std::vector<ProcessStep>& process);
 struct SeparationCampaign {

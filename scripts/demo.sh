@@ -137,9 +137,10 @@ $PL simulate "$S/plan-compensated/roughing.ngc" "$S/plan-compensated/finishing.n
 $PL evaluate "$S/run-compensated/cmm_export.csv" --probe-log "$S/run-compensated/sw_probe.log" \
   --manifest "$S/plan-compensated/plan.json" --compare "$S/eval/evaluation.json" --out "$S/eval-compensated" | grep -A13 'against' | sed 's/^/   /'
 $PL report stepped --evaluation "$S/eval-compensated/evaluation.json" --html "$S/report.html" | sed 's/^/   /'
-echo "-- the campaign (Sec. 3.5): thermal stages W6 / W1 / W7 (1000 / 3500 / 5500 rpm), W8's process error without them"
+echo "-- the campaign (Sec. 3.5-3.6): thermal stages W6 / W1 / W7 (1000 / 3500 / 5500 rpm), W8's process error without them,"
+echo "   the control errors of W2 (transitions at 1200 mm/min) and W5 (one continuous path) against W8"
 seed=11
-for W in W6 W1 W7; do
+for W in W6 W1 W7 W2 W5; do
   $PL plan parts/stepped_workpiece.yaml --machine parts/machines/vmc3.yaml --out "$S/$W/plan" --experiment $W > /dev/null
   $PL simulate "$S/$W/plan/roughing.ngc" "$S/$W/plan/finishing.ngc" "$S/$W/plan/probing.ngc" --machine parts/machines/vmc3.yaml \
     --part parts/stepped_workpiece.yaml --truth examples/stepped_workpiece/truth.yaml --cmm-points "$S/$W/plan/cmm_points.csv" \
@@ -148,7 +149,8 @@ for W in W6 W1 W7; do
   seed=$((seed + 1))
 done
 $PL separate --stage "$S/W6/eval/evaluation.json" --stage "$S/W1/eval/evaluation.json" --stage "$S/W7/eval/evaluation.json" \
-  --process "$S/eval/evaluation.json" --out "$S/separation" | sed 's/^/   /'
+  --process "$S/eval/evaluation.json" --control "$S/W2/eval/evaluation.json" --force "$S/W5/eval/evaluation.json" \
+  --out "$S/separation" | grep -v '^    ' | sed 's/^/   /'
 echo "-- W3 (speeds 3500 / 5500 / 1000 / 3500 rpm step by step) predicted from the campaign"
 $PL plan parts/stepped_workpiece.yaml --machine parts/machines/vmc3.yaml --out "$S/W3/plan" --experiment W3 \
   --predict-from "$S/separation/separation.json" | sed -n '/^Compensated/,/^Steps/p' | sed '$d' | sed 's/^/   /'
@@ -173,8 +175,7 @@ for round in 1 2 3 4; do
   $PL ${cmd#probeloop } > /dev/null
   $PL model fit "$S/series/model.yaml" | grep -E '^[a-z_]+_um  |validation  |validation, before' | sed 's/^/     /'
 done
-echo "   (the thesis's tables are reproduced by evaluate/stepped_separation_test; the control errors come next:"
-echo "    docs/stepped-workpiece.md)"
+echo "   (the thesis's tables are reproduced by evaluate/stepped_separation_test; docs/stepped-workpiece.md)"
 
 echo
 echo "Outputs: $OUT/plan (G-code, manifest), $OUT/run (controller log, points.csv, inputs.csv, truth.json),"
@@ -183,5 +184,5 @@ echo "         $OUT/campaign (72 h: model.yaml, diagnosis-*.html, fit-*.html wit
 echo "         $OUT/ttp (thermal test piece: plan/, run/, cmm/ and om/ evaluations, report.html, cmm/test_piece.gltf, r-test/, fit.html),"
 echo "         $OUT/stepped (stepped workpiece W8: plan/ with the roughing, finishing, probing programs; run/ with cmm_export.csv, sw_probe.log; eval/ with compensation.json;
          plan-compensated/, run-compensated/, eval-compensated/ with before/after; report.html;
-         W6/, W1/, W7/ the thermal stages, separation/ the campaign, W3/plan the program predicted from it,
+         W6/, W1/, W7/ the thermal stages, W2/, W5/ the control parts, separation/ the campaign (control.csv), W3/plan the program predicted from it,
          W3plain/, series/ the model loop's inputs.csv, errors.csv, model.yaml and each round's diagnosis)"

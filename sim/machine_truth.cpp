@@ -281,6 +281,15 @@ MachineTruth loadMachineTruth(const std::string& path) {
       t.stiffness_N_per_um(k) = st->numberOr(keys[k], 0);
       if (t.stiffness_N_per_um(k) < 0) st->fail(keys[k], "must not be negative (0 = rigid)");
     }
+    const char* lost[] = {"lost_motion_x_um_per_m_per_min", "lost_motion_y_um_per_m_per_min",
+                          "lost_motion_z_um_per_m_per_min"};
+    for (int k = 0; k < 3; ++k) {
+      t.lost_motion_um_per_m_per_min(k) = st->numberOr(lost[k], 0);
+      if (!(t.lost_motion_um_per_m_per_min(k) >= 0)) st->fail(lost[k], "must not be negative (0 = none)");
+    }
+    t.lost_motion_max_um = st->numberOr("lost_motion_max_um", 0);
+    if (t.lost_motion_um_per_m_per_min != Eigen::Vector3d::Zero() && !(t.lost_motion_max_um > 0))
+      st->fail("lost_motion_max_um", "must be given and positive with a lost motion (a rapid would otherwise wind a drive up without bound)");
     st->finish();
   }
   t.inputs_rate_s = root.quantityOr("inputs_rate", Dimension::Duration, 60);

@@ -132,6 +132,13 @@ struct MachineTruth {
   // Static stiffness of the structure at the tool (seed 003: F/k), N/um per machine axis;
   // 0 = rigid.
   Eigen::Vector3d stiffness_N_per_um = Eigen::Vector3d::Zero();
+  // Speed-dependent lost motion of each drive (um per m/min of the axis's last speed, capped
+  // at lost_motion_max_um): a semi-closed-loop drive's screw and nut wound up by friction
+  // while the axis moved, held by stiction when it stops; the tip lags the command against
+  // the axis's last direction. A wall cut after a fast transition sits further out than after
+  // a slow one: the simulator's stand-in for seed 000's control error (docs/simulator.md).
+  Eigen::Vector3d lost_motion_um_per_m_per_min = Eigen::Vector3d::Zero();
+  double lost_motion_max_um = 0;
 
   geometry::LocationErrors keyframeAt(double t_s) const;
 };

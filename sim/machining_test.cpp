@@ -231,6 +231,33 @@ TEST(Machining, AScaleErrorStretchesTheAxisFromItsZero) {
   EXPECT_EQ(r.out.log_text, "42.978511\n");
 }
 
+// A drive's lost motion grows with the axis's speed and is held while the axis stands: the +X
+// wall (x 35, cut along +Y) reached by a -X move at F sits 5 um/(m/min) x F further out (the tip
+// lags the command against the move), capped at 6 um; the CMM sees it (no MPE). The probe,
+// calibrated at its feed, does not see its own approach's lag.
+TEST(Machining, ADrivesLostMotionGrowsWithItsSpeedUpToItsCapAndIsHeld) {
+  const auto truth = truthFrom("structure: {lost_motion_x_um_per_m_per_min: 5, lost_motion_max_um: 6}\n");
+  const auto wallAfter = [&](const std::string& F) {
+    const std::string prog = "G21 G90 G17 G94\nG10 L2 P6 X0 Y0 Z0 C0\nG59\nT1 M6\nG43 H1\nS8000 M3\nG0 X45 Y-40 Z60\nG0 Z30\n"
+                             "G1 X40 F" + F + "\nG1 Y-30 F600\nG1 Y30\nG1 Y40\nG0 Z60\nM5\nM2\n";
+    const auto r = machine(truth, block(0.0), prog);
+    double x = 0;
+    for (std::size_t i = 9; i < 15; ++i) x += r.cmm[i].x() / 6;  // the WALL points
+    return x;
+  };
+  EXPECT_NEAR(wallAfter("100"), 35.0005, kCmmDigit);   // 0.1 m/min: 0.5 um
+  EXPECT_NEAR(wallAfter("1000"), 35.005, kCmmDigit);   // 1 m/min: 5 um
+  EXPECT_NEAR(wallAfter("3000"), 35.006, kCmmDigit);   // 15 um asked, 6 um held
+  const std::string probe = "G21 G90\nT99 M6\nG43 H99\nG0 X50 Y0 Z60\nG0 Z20\nG38.2 X38 F3000\n(LOGOPEN,p.log)\n(LOG,#5061)\nM2\n";
+  EXPECT_EQ(machine(truth, block(0.0), probe, {}).out.log_text, "43.000000\n");
+  try {
+    truthFrom("structure: {lost_motion_y_um_per_m_per_min: 4}\n");
+    FAIL() << "a lost motion without its cap was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("lost_motion_max_um"), std::string::npos) << e.what();
+  }
+}
+
 // Axis motion heats a node: 10 W per m/min at F1000 for 720 s of air moves; the node's
 // sensor (no noise, no offset) follows dT = Q/G (1 - exp(-t G/C)), Q = 10 W, tau = 400 s.
 TEST(Machining, AxisMotionIsAHeatSource) {

@@ -276,6 +276,7 @@ nlohmann::ordered_json featuresJson(const std::vector<AsCutFeature>& fs, const s
       m["deflection_um"] = vec(cs->deflection_um);
       m["axes_um"] = {vec(cs->axes_start_um), vec(cs->axes_end_um)};
       if (cs->scale_um_per_mm != Eigen::Vector3d::Zero()) m["scale_um_per_mm"] = vec(cs->scale_um_per_mm);
+      if (cs->lost_motion_um != Eigen::Vector3d::Zero()) m["lost_motion_um"] = vec(cs->lost_motion_um);
       j["machine"] = m;
     } else {
       j["machine"] = nullptr;

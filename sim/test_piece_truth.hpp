@@ -56,6 +56,9 @@ struct CutState {
   // The axes' scale errors from the thermal nodes (and a static EXX_um_per_mm …) at the cut:
   // the thermal position error e_pt of seed 000 is this times the travel (um per mm).
   Eigen::Vector3d scale_um_per_mm = Eigen::Vector3d::Zero();
+  // The drives' speed-dependent lost motion held at the cut (tool side, um): what the last
+  // moves of each axis left (MachineTruth::lost_motion_um_per_m_per_min).
+  Eigen::Vector3d lost_motion_um = Eigen::Vector3d::Zero();
 };
 
 struct AsCutFeature {

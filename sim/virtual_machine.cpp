@@ -84,8 +84,9 @@ struct ProbeEvent {
   std::array<double, 7> apparent{};  // what a sphere evaluation sees (docs/simulator.md)
   double pretravel_um = 0, noise_um = 0;
   Vector3d reported_tip_mm = Vector3d::Zero();  // latched, machine coordinates of the tip
-  // Workpiece probing: the tool-side error of the linear axes (geometric errors and
-  // squareness, not the drift) at the contact; what a CMM - probe comparison sees.
+  // Workpiece probing: the tool-side error of the linear axes (geometric errors, squareness and
+  // the still axes' held lost motion; not the drift, nor the approach's lag, which the stylus's
+  // calibration holds) at the contact; what a CMM - probe comparison sees.
   std::optional<Vector3d> axes_um;
   Vector3d scale_um_per_mm = Vector3d::Zero();  // the axes' scale errors (static + thermal) then
 };
@@ -132,6 +133,7 @@ class VirtualMachine : public gcode::MachineInterface {
     t = std::max(t, rotaryTime(to.c_deg - pos_.c_deg, m_.c));
     t = std::max(t, rotaryTime(to.b_deg - pos_.b_deg, m_.b));
     const double t0 = t_;
+    noteAxesMotion(to.xyz_mm, t);
     move(t, t > 0 ? (to.xyz_mm - pos_.xyz_mm).norm() / t * 60.0 : 0.0);
     traceRow("rapid", to, 0, t0);
     pos_ = to;
@@ -154,6 +156,7 @@ class VirtualMachine : public gcode::MachineInterface {
     const double t0 = t_;
     const double dt = (len > 0 ? len : rot) / F * 60.0;
     c_move_rpm_ = cMoveRpm(to, dt);
+    noteAxesMotion(to.xyz_mm, dt);
     move(dt, len > 0 ? F : 0.0);
     c_move_rpm_ = 0;
     traceRow("feed", to, F, t0);
@@ -183,6 +186,7 @@ class VirtualMachine : public gcode::MachineInterface {
     const Vector3d g0 = pos_.xyz_mm, g1 = to.xyz_mm;
     const double len = (g1 - g0).norm();
     if (len <= 0) throw InputError("", 0, "a probe move of zero length");
+    noteAxesMotion(g1, len / F * 60.0);
     const Vector3d dir = (g1 - g0) / len;
     if (!a_) return probeWorkpiece(to, F, dir, len, mode);
     const Vector3d a = tipActual(g0), b = tipActual(g1);
@@ -236,6 +240,10 @@ class VirtualMachine : public gcode::MachineInterface {
   gcode::ProbeOutcome latchTrigger(ProbeEvent ev, const Vector3d& dir, double travel_mm, double F) {
     ev.noise_um = tr_.probe.noise_um > 0 ? tr_.probe.noise_um * noise_normal_(noise_rng_) : 0.0;
     Vector3d latched = pos_.xyz_mm + travel_mm * dir + ev.noise_um * 1e-3 * dir;
+    // The stylus is calibrated at the probing feed (as for its pre-travel): the lag of the axes
+    // that move in the approach is in its effective radius; a still axis's held lag is not.
+    for (int k = 0; k < 3; ++k)
+      if (std::fabs(dir(k)) > 1e-12) latched(k) += lost_motion_um_(k) * 1e-3;
     if (tr_.probe.quantise) {
       const double q[3] = {m_.x.resolution_mm, m_.y.resolution_mm, m_.z.resolution_mm};
       for (int k = 0; k < 3; ++k) latched(k) = std::round(latched(k) / q[k]) * q[k];
@@ -408,6 +416,7 @@ class VirtualMachine : public gcode::MachineInterface {
   MachinePosition pos_;
   int tool_ = 0;
   Vector3d atc_um_ = Vector3d::Zero();
+  Vector3d lost_motion_um_ = Vector3d::Zero();  // the drives' wind-up held now (tool side)
   double spindle_rpm_ = 0;
   double path_speed_mm_per_min_ = 0;
   bool off_ = false;  // machineOff: every heat input off
@@ -618,6 +627,20 @@ class VirtualMachine : public gcode::MachineInterface {
     return d + atc_um_;
   }
 
+  // A move from pos_ to `to` lasting dt_s winds each moving axis's drive up against its
+  // direction, in proportion to the axis's speed (capped); a still axis keeps what its last
+  // move left (MachineTruth::lost_motion_um_per_m_per_min).
+  void noteAxesMotion(const Vector3d& to, double dt_s) {
+    if (tr_.lost_motion_um_per_m_per_min == Vector3d::Zero() || !(dt_s > 0)) return;
+    for (int k = 0; k < 3; ++k) {
+      const double dk = to(k) - pos_.xyz_mm(k);
+      if (std::fabs(dk) < 1e-9) continue;
+      const double v_m_per_min = std::fabs(dk) / dt_s * 60.0 / 1000.0;
+      const double lag = std::min(tr_.lost_motion_um_per_m_per_min(k) * v_m_per_min, tr_.lost_motion_max_um);
+      lost_motion_um_(k) = dk > 0 ? -lag : lag;
+    }
+  }
+
   // The axes' scale errors now: static plus each node's per kelvin of its rise (um per mm).
   Vector3d scaleUmPerMm() const {
     Vector3d s(tr_.static_errors.scale_um_per_mm[0], tr_.static_errors.scale_um_per_mm[1],
@@ -668,6 +691,7 @@ class VirtualMachine : public gcode::MachineInterface {
     }
     // Scale errors (static and thermal): EXX = s x at the machine coordinate.
     d += scaleUmPerMm().cwiseProduct(g) * 1e-3;
+    d += lost_motion_um_ * 1e-3;
     // Squareness as right-hand rotations of the Y and Z axes (docs/simulator.md).
     d.x() += -tr_.EC0Y_urad * 1e-6 * g.y() + tr_.EB0Z_urad * 1e-6 * g.z();
     d.y() += -tr_.EA0Z_urad * 1e-6 * g.z();
@@ -1029,6 +1053,7 @@ class VirtualMachine : public gcode::MachineInterface {
     s.tool_um = toolDriftUm();
     s.part_above_20C_K = workpieceAbove20K();
     s.scale_um_per_mm = scaleUmPerMm();
+    s.lost_motion_um = lost_motion_um_;
     cut_states_.push_back(s);
   }
 
@@ -1042,6 +1067,8 @@ class VirtualMachine : public gcode::MachineInterface {
     if (to.b_deg != pos_.b_deg || (to.c_deg != pos_.c_deg && to.xyz_mm != pos_.xyz_mm))
       throw InputError("", 0, "cutting with a rotary axis moving together with X/Y/Z (or B) is not modelled");
     if (to.c_deg != pos_.c_deg) return arcCut(to, F);
+    const double len_cut = (to.xyz_mm - pos_.xyz_mm).norm();
+    noteAxesMotion(to.xyz_mm, len_cut / F * 60.0);
     const Vector3d w0 = toWorkpiece(tipActual(pos_.xyz_mm)), w1 = toWorkpiece(tipActual(to.xyz_mm));
     const double table_z = m_.table_surface_z_mm - w_->frame_origin_mm.z();
     if (w0.z() < table_z - 1e-9 || w1.z() < table_z - 1e-9)
@@ -1201,6 +1228,8 @@ class VirtualMachine : public gcode::MachineInterface {
     ev.location = locationErrors();
     ev.tool_um = toolDriftUm();
     ev.axes_um = axesErrorUm(pos_.xyz_mm + dir * s_contact);
+    for (int k = 0; k < 3; ++k)  // what the calibrated stylus takes out (latchTrigger)
+      if (std::fabs(dir(k)) > 1e-12) (*ev.axes_um)(k) -= lost_motion_um_(k);
     ev.scale_um_per_mm = scaleUmPerMm();
     ev.atc_um = atc_um_;
     ev.settling_um = settlingUm();

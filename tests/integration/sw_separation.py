@@ -108,7 +108,7 @@ def truth_recovery(label, run_dir, ev_dir):
         for a, axis, P, N in ((0, "x", "XP", "XN"), (1, "y", "YP", "YN")):
             t = sw.mean_axis(f"S{k}_{P}", a) - sw.mean_axis(f"S{k}_{N}", a)
             near(f"step {k} e_pos_{axis}", s[f"e_pos_{axis}_um"], t, resolved=k >= 3)
-            t = sw.deflection(k, a) + sw.thermal(k, a)
+            t = sw.deflection(k, a) + sw.thermal(k, a) + sw.lost_motion(k, a)
             near(f"step {k} e_proc_{axis} (F {s['feed_mm_per_min']:.0f})", s[f"e_proc_{axis}_um"], t, resolved=k == 4)
         near(f"step {k} e_pos_z", s["e_pos_z_um"], sw.mean_axis("TOP", 2) - sw.mean_axis(f"S{k}_F", 2))
         t = feats[f"S{k}_F"]["machine"]["tool_um"][2] - feats["TOP"]["machine"]["tool_um"][2]

@@ -31,6 +31,13 @@ class SwTruth:
         P, N = ("XP", "XN") if a == 0 else ("YP", "YN")
         return along_normal(self.feats[f"S{k}_{P}"], "deflection_um") + along_normal(self.feats[f"S{k}_{N}"], "deflection_um")
 
+    def lost_motion(self, k, a):
+        """Two-wall sum of the drives' lost motion held when step k's walls were cut (um, outward):
+        the simulator's control error (structure.lost_motion_*), 0 when the truth has none."""
+        P, N = ("XP", "XN") if a == 0 else ("YP", "YN")
+        return sum(along_normal(self.feats[f"S{k}_{w}"], "lost_motion_um") if "lost_motion_um" in self.feats[f"S{k}_{w}"]["machine"] else 0.0
+                   for w in (P, N))
+
     def thermal(self, k, a):
         """The thermal position error e_pt of step k's width (um): the axis's scale error when the
         two walls were cut minus when the probe touched them (CMM - probe puts that one into
@@ -40,3 +47,12 @@ class SwTruth:
         ev = self.events[f"S{k}_{P}"] + self.events[f"S{k}_{N}"]
         probe = sum(self.scale(e, a) for e in ev) / len(ev)
         return (cut - probe) * (self.sizes[k - 1] + self.tool_d)
+
+    def thermal_from_zero(self, k, a):
+        """e_pt as the campaign separates it (seed 000 Sec. 3.5): the scale error when step k's walls
+        were cut minus at the thermal zero, the top's cut (finishing's first, T = 0), over the tool
+        centre's travel. What thermal() holds beyond it, (top - probe) x travel, grows with the
+        step as T does: a stage's line takes part of it with e_pt, its intercept the rest."""
+        P, N = ("XP", "XN") if a == 0 else ("YP", "YN")
+        cut = (self.scale(self.feats[f"S{k}_{P}"]["machine"], a) + self.scale(self.feats[f"S{k}_{N}"]["machine"], a)) / 2
+        return (cut - self.scale(self.feats["TOP"]["machine"], a)) * (self.sizes[k - 1] + self.tool_d)
