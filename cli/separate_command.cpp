@@ -46,6 +46,7 @@ int run(const SeparateArgs& a) {
   writeFileAtomic((std::filesystem::path(a.out) / "separation.json").string(), json);
   writeFileAtomic((std::filesystem::path(a.out) / "separation.csv").string(), csv);
   if (control) writeFileAtomic((std::filesystem::path(a.out) / "control.csv").string(), ccsv);
+  else std::filesystem::remove(std::filesystem::path(a.out) / "control.csv");  // not a stale one from an earlier run
   std::fputs(model::separationSummary(st, process).c_str(), stdout);
   if (control) std::fputs(model::controlSummary(*control).c_str(), stdout);
   std::printf("  wrote separation.json, separation.csv%s in %s\n", control ? ", control.csv" : "", a.out.c_str());

@@ -1,5 +1,6 @@
 #include "model/control_errors.hpp"
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
 
@@ -23,14 +24,39 @@ Joining joiningOf(const json& e, const std::string& file) {
   if (!e.contains("transition") || !e.at("transition").is_string())
     throw InputError(file, 0, "transition: missing (an evaluation.json written before the control separation: run evaluate again)");
   Joining j{e.at("transition").get<std::string>(), 0};
+  if (j.transition != "non_cutting" && j.transition != "fast" && j.transition != "continuous")
+    throw InputError(file, 0, "transition: '" + j.transition + "'; expected non_cutting, fast or continuous");
+  if (e.at("separation").empty()) throw InputError(file, 0, "separation: no steps");
   if (j.transition != "continuous") j.feed_mm_per_min = evaluationNumber(e, "transition_feed_mm_per_min", "", file);
   return j;
 }
 
-ThermalValue referenceAt(const SteppedComponent& c, double feed) {
+// The polynomial's leverage at x, g' (X'X)^-1 g with g = (1, x, x^2 …), x scaled by the largest
+// measured value.
+double leverage(const SteppedComponent& c, double x) {
+  const int p = static_cast<int>(c.fit.function.p.size());
+  const double s = c.x_max > 0 ? c.x_max : 1.0;
+  Eigen::MatrixXd X(static_cast<Eigen::Index>(c.x.size()), p);
+  for (std::size_t i = 0; i < c.x.size(); ++i)
+    for (int j = 0; j < p; ++j) X(static_cast<Eigen::Index>(i), j) = std::pow(c.x[i] / s, j);
+  Eigen::VectorXd g(p);
+  for (int j = 0; j < p; ++j) g(j) = std::pow(x / s, j);
+  return g.dot((X.transpose() * X).ldlt().solve(g));
+}
+
+// The reference's process error at a feed. Inside its feeds u is the line's out-of-sample u
+// (u_pred: the points' u and the leave-one-out RMS); beyond them it grows with the line's
+// leverage against the largest at a measured feed, sqrt(h(F) / h_max).
+ThermalValue referenceAt(const SteppedComponent& c, double feed, const std::string& file) {
+  if (!(feed >= 0) || feed > 2.0 * c.x_max)
+    throw InputError(file, 0, "feed_mm_per_min: " + formatNumber(feed) + " mm/min lies beyond twice the reference's largest feed (" +
+                                  formatNumber(c.x_max) + " mm/min): its process error is not extrapolated that far");
   ThermalValue v;
   v.value_um = c.at(feed);
-  v.u_um = c.u_pred_um;
+  double h_max = 0;
+  for (double x : c.x) h_max = std::max(h_max, leverage(c, x));
+  const double h = leverage(c, feed);
+  v.u_um = c.u_pred_um * (h > h_max && h_max > 0 ? std::sqrt(h / h_max) : 1.0);
   v.k95 = c.k95;
   v.basis = c.fit.function.formula();
   return v;
@@ -58,8 +84,8 @@ std::vector<ControlStep> separateAgainst(const ControlSeparation& c, const Therm
     s.u_one_part_y_um = p.u_one_part_y_um;
     s.pt_x = p.pt_x;
     s.pt_y = p.pt_y;
-    s.ref_x = referenceAt(c.reference_x, s.feed_mm_per_min);
-    s.ref_y = referenceAt(c.reference_y, s.feed_mm_per_min);
+    s.ref_x = referenceAt(c.reference_x, s.feed_mm_per_min, file);
+    s.ref_y = referenceAt(c.reference_y, s.feed_mm_per_min, file);
     const double tol = 1e-6 * c.reference_feed_max;
     s.extrapolated = s.feed_mm_per_min < c.reference_feed_min - tol || s.feed_mm_per_min > c.reference_feed_max + tol;
     // Eq. 3.11/3.12 (e_ctrl) and Eq. 3.15 reduced to W8 (e_cpr): the part's value minus e_pt
@@ -220,7 +246,7 @@ std::string controlCsv(const ControlSeparation& c) {
 
 std::string controlSummary(const ControlSeparation& c) {
   std::string s = "Control errors against " + c.reference_experiment + " (its transitions at " +
-                  formatNumber(c.reference_transition_feed_mm_per_min) + " mm/min, the zero of control error):\n"
+                  formatNumber(c.reference_transition_feed_mm_per_min) + " mm/min: the control errors are measured from them):\n"
                   "    its process error on the feed, X: " + steppedComponentSummary(c.reference_x) + "\n"
                   "    Y: " + steppedComponentSummary(c.reference_y) + "\n";
   auto line = [&](const ControlStep& p) {

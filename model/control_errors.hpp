@@ -16,11 +16,12 @@
 //     what the continuous path adds to W5's widths. e_cpr is then regressed on the feed (Eq. 5.56).
 // u: the three terms' u in quadrature (e_pt enters both this part's and the reference's values,
 // partly correlated: counted twice, so u is on the safe side); U = sqrt((2 u_part)^2 + (k u_pt)^2
-// + (k u_ref)^2). A feed outside the reference's range is extrapolated: computed, flagged.
+// + (k u_ref)^2). A feed beyond the reference's is extrapolated (flagged), u_ref growing with the
+// line's leverage there, up to twice the largest reference feed; further is refused.
 //
-// Contract: InputError naming the file: not a stepped evaluation; no transition recorded (an
-// evaluation.json from before this field: evaluate again); a reference joined by a continuous
-// path; a transitions part that is continuous or no faster than the reference; a force part that
+// Contract: InputError naming the file: not a stepped evaluation or no steps; no transition
+// recorded (an evaluation.json from before this field: evaluate again) or an unknown one; a
+// reference joined by a continuous path; a feed beyond twice the reference's largest; a transitions part that is continuous or no faster than the reference; a force part that
 // is not continuous; a step at a speed other than the reference's (e_ref holds at its speed).
 #pragma once
 #include <nlohmann/json.hpp>

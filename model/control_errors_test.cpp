@@ -64,6 +64,11 @@ TEST(ControlErrors, TheTransitionsPartKeepsWhatItsJoiningAddsAtEveryFeed) {
     EXPECT_NEAR(s.u_x_um, std::sqrt(0.25 + s.pt_x.u_um * s.pt_x.u_um + s.ref_x.u_um * s.ref_x.u_um), 1e-12);
   }
   EXPECT_EQ(c.transitions[0].quantity, "e_ctrl");
+  // Inside the reference's feeds u_ref is the line's out-of-sample u; at 1600 mm/min it grows with
+  // the line's leverage: feeds 100/200/400/800 (mean 375, Sxx 287500) give h = 1/4 + (F - 375)^2 / Sxx,
+  // 0.8783 at 800 (the largest measured) and 5.4696 at 1600: sqrt(5.4696 / 0.8783) = 2.4955.
+  EXPECT_DOUBLE_EQ(c.transitions[2].ref_x.u_um, c.reference_x.u_pred_um);
+  EXPECT_NEAR(c.transitions[3].ref_x.u_um / c.reference_x.u_pred_um, std::sqrt((0.25 + 1225.0 * 1225.0 / 287500) / (0.25 + 425.0 * 425.0 / 287500)), 1e-9);
 }
 
 TEST(ControlErrors, TheForcePartIsMeasuredFromTheReferenceAndRegressedOnTheFeed) {
@@ -79,15 +84,10 @@ TEST(ControlErrors, TheForcePartIsMeasuredFromTheReferenceAndRegressedOnTheFeed)
   ASSERT_TRUE(c.has_force_fit);
   EXPECT_NEAR(c.force_x.at(600), -6.0, 1e-9);
   EXPECT_TRUE(c.transitions.empty());
-  // The thesis's Eq. 3.15 through W2 gives the same: (W2 - W5) - the process difference - e_ctrl.
+  // W2 given too: e_cpr does not depend on it (Eq. 3.15's route through W2 cancels its terms).
   const json w2 = part("W2", "fast", 1200, kFW8, -1.0, 0.01, 5.0, 5.0);
   const auto both = separateControl(oneStage(), kW8, "w8.json", &w2, "w2.json", &w5, "w5.json");
-  for (int i = 0; i < 4; ++i) {
-    const auto &a = both.transitions[static_cast<std::size_t>(i)], &b = both.force[static_cast<std::size_t>(i)];
-    const double eq315 = (a.one_part_x_um - b.one_part_x_um) - (a.ref_x.value_um - b.ref_x.value_um) -
-                         (a.pt_x.value_um - b.pt_x.value_um) - a.x_um;
-    EXPECT_NEAR(-eq315, b.x_um, 1e-9);  // Eq. 3.15's bracket is what W5 lacks: the sign turned
-  }
+  for (int i = 0; i < 4; ++i) EXPECT_NEAR(both.force[static_cast<std::size_t>(i)].x_um, -0.01 * kFW8[i], 1e-9);
 }
 
 void expectRefusal(const json& ref, const json* w2, const json* w5, const std::string& want) {
@@ -112,6 +112,15 @@ TEST(ControlErrors, PartsJoinedTheWrongWayOrAtAnotherSpeedAreRefused) {
   expectRefusal(kW8, &slow, nullptr, "w2.json: transition_feed_mm_per_min: 100 mm/min");
   const json other_speed = part("W2", "fast", 1200, kFW2, -1.0, 0.01, 0, 0, 5500);
   expectRefusal(kW8, &other_speed, nullptr, "holds at its speed, 3500 rpm");
+  const double far[4] = {200, 400, 800, 1700};
+  const json too_fast = part("W2", "fast", 1200, far, -1.0, 0.01, 0, 0);
+  expectRefusal(kW8, &too_fast, nullptr, "w2.json: feed_mm_per_min: 1700 mm/min lies beyond twice the reference's largest feed (800 mm/min)");
+  json unknown = w2;
+  unknown["transition"] = "zigzag";
+  expectRefusal(kW8, &unknown, nullptr, "w2.json: transition: 'zigzag'");
+  json empty = kW8;
+  empty["separation"] = json::array();
+  expectRefusal(empty, &w2, nullptr, "ref.json: separation: no steps");
 }
 
 }  // namespace

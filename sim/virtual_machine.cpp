@@ -243,7 +243,7 @@ class VirtualMachine : public gcode::MachineInterface {
     // The stylus is calibrated at the probing feed (as for its pre-travel): the lag of the axes
     // that move in the approach is in its effective radius; a still axis's held lag is not.
     for (int k = 0; k < 3; ++k)
-      if (std::fabs(dir(k)) > 1e-12) latched(k) += lost_motion_um_(k) * 1e-3;
+      if (lost_motion_moving_[k]) latched(k) += lost_motion_um_(k) * 1e-3;
     if (tr_.probe.quantise) {
       const double q[3] = {m_.x.resolution_mm, m_.y.resolution_mm, m_.z.resolution_mm};
       for (int k = 0; k < 3; ++k) latched(k) = std::round(latched(k) / q[k]) * q[k];
@@ -417,6 +417,7 @@ class VirtualMachine : public gcode::MachineInterface {
   int tool_ = 0;
   Vector3d atc_um_ = Vector3d::Zero();
   Vector3d lost_motion_um_ = Vector3d::Zero();  // the drives' wind-up held now (tool side)
+  std::array<bool, 3> lost_motion_moving_{};     // the axes the last move moved (set it)
   double spindle_rpm_ = 0;
   double path_speed_mm_per_min_ = 0;
   bool off_ = false;  // machineOff: every heat input off
@@ -634,7 +635,8 @@ class VirtualMachine : public gcode::MachineInterface {
     if (tr_.lost_motion_um_per_m_per_min == Vector3d::Zero() || !(dt_s > 0)) return;
     for (int k = 0; k < 3; ++k) {
       const double dk = to(k) - pos_.xyz_mm(k);
-      if (std::fabs(dk) < 1e-9) continue;
+      lost_motion_moving_[k] = std::fabs(dk) >= 1e-9;
+      if (!lost_motion_moving_[k]) continue;
       const double v_m_per_min = std::fabs(dk) / dt_s * 60.0 / 1000.0;
       const double lag = std::min(tr_.lost_motion_um_per_m_per_min(k) * v_m_per_min, tr_.lost_motion_max_um);
       lost_motion_um_(k) = dk > 0 ? -lag : lag;
@@ -1229,7 +1231,7 @@ class VirtualMachine : public gcode::MachineInterface {
     ev.tool_um = toolDriftUm();
     ev.axes_um = axesErrorUm(pos_.xyz_mm + dir * s_contact);
     for (int k = 0; k < 3; ++k)  // what the calibrated stylus takes out (latchTrigger)
-      if (std::fabs(dir(k)) > 1e-12) (*ev.axes_um)(k) -= lost_motion_um_(k);
+      if (lost_motion_moving_[k]) (*ev.axes_um)(k) -= lost_motion_um_(k);
     ev.scale_um_per_mm = scaleUmPerMm();
     ev.atc_um = atc_um_;
     ev.settling_um = settlingUm();
