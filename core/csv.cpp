@@ -17,11 +17,11 @@ std::string trim(const std::string& s) {
   while (b > a && std::isspace(static_cast<unsigned char>(s[b - 1]))) --b;
   return s.substr(a, b - a);
 }
-std::vector<std::string> split(const std::string& line) {
+std::vector<std::string> split(const std::string& line, char sep) {
   std::vector<std::string> out;
   std::string cur;
   for (char c : line) {
-    if (c == ',') {
+    if (c == sep) {
       out.push_back(trim(cur));
       cur.clear();
     } else {
@@ -51,10 +51,18 @@ double CsvTable::number(const CsvRow& row, int col) const {
     throw InputError(file, row.line, "missing field '" + header.at(col) + "'");
   const std::string& f = row.fields[col];
   double v = 0;
-  if (!parseFiniteNumber(f, v))
-    throw InputError(file, row.line,
-                     "field '" + header[col] + "': '" + f + "' is not a finite number");
-  return v;
+  if (separator == ';' && f.find(',') != std::string::npos) {
+    if (f.find('.') != std::string::npos || f.find(',') != f.rfind(','))
+      throw InputError(file, row.line,
+                       "field '" + header[col] + "': '" + f +
+                           "' is not a number: one decimal mark, a comma or a point, and no thousands separators");
+    std::string g = f;
+    g[g.find(',')] = '.';
+    if (parseFiniteNumber(g, v)) return v;
+  } else if (parseFiniteNumber(f, v)) {
+    return v;
+  }
+  throw InputError(file, row.line, "field '" + header[col] + "': '" + f + "' is not a finite number");
 }
 
 CsvTable parseCsv(const std::string& text, const std::string& file_name) {
@@ -65,20 +73,27 @@ CsvTable parseCsv(const std::string& text, const std::string& file_name) {
   int n = 0;
   while (std::getline(in, line)) {
     ++n;
+    if (n == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 byte-order mark
     if (!line.empty() && line.back() == '\r') line.pop_back();
     const std::string tl = trim(line);
     if (tl.empty() || tl[0] == '#') continue;
-    auto fields = split(tl);
     if (t.header.empty()) {
-      t.header = fields;
+      const bool semi = tl.find(';') != std::string::npos, comma = tl.find(',') != std::string::npos;
+      if (semi && comma)
+        throw InputError(file_name, n, "the header holds both ',' and ';': which one separates the columns cannot be told");
+      t.separator = semi ? ';' : ',';
+      t.header = split(tl, t.separator);
       t.header_line = n;
       continue;
     }
+    auto fields = split(tl, t.separator);
     if (fields.size() != t.header.size())
       throw InputError(file_name, n,
                        "expected " + std::to_string(t.header.size()) + " fields (header line " +
-                           std::to_string(t.header_line) + "), found " +
-                           std::to_string(fields.size()));
+                           std::to_string(t.header_line) + "), found " + std::to_string(fields.size()) +
+                           (t.separator == ',' && fields.size() > t.header.size()
+                                ? " (decimal commas? a comma-separated file cannot hold them: separate the columns with ';')"
+                                : ""));
     t.rows.push_back({n, std::move(fields)});
   }
   if (t.header.empty()) throw InputError(file_name, 0, "no header row");

@@ -1,5 +1,13 @@
-// Minimal CSV reading with line numbers: comma-separated, '#' starts a comment line,
-// blank lines skipped, no quoting (none of the project's formats needs it).
+// Minimal CSV reading with line numbers: '#' starts a comment line, blank lines skipped, no
+// quoting (none of the project's formats needs it); CRLF line ends and a UTF-8 byte-order mark
+// are accepted.
+//
+// Separator and decimal mark, decided from the header line alone so that a number can never be
+// misread: a header with ';' and no ',' makes the file semicolon-separated, and then a number
+// may use a decimal comma ("1,25") or a decimal point, never both in one field (no thousands
+// separators); otherwise the file is comma-separated with decimal points, and a row with more
+// fields than the header is refused with the hint that decimal commas need ';'. A header with
+// both ',' and ';' is refused: which one separates cannot be told.
 #pragma once
 #include <string>
 #include <vector>
@@ -16,9 +24,11 @@ struct CsvTable {
   int header_line = 0;
   std::vector<std::string> header;
   std::vector<CsvRow> rows;
+  char separator = ',';        // ';' when the header says so (see above)
 
   int column(const std::string& name) const;  // -1 if absent
-  // Parses fields[col] of a row as a finite double; InputError with file:line:column name.
+  // Parses fields[col] of a row as a finite double (a decimal comma in a ';' file);
+  // InputError with file:line:column name.
   double number(const CsvRow& row, int col) const;
 };
 

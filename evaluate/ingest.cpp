@@ -1,5 +1,6 @@
 #include "evaluate/ingest.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <set>
@@ -26,9 +27,21 @@ bool looksLikeCsv(const std::string& text) {
   std::istringstream in(text);
   for (std::string line; std::getline(in, line);) {
     if (line.empty() || line[0] == '#') continue;
-    return line.find(',') != std::string::npos;
+    return line.find(',') != std::string::npos || line.find(';') != std::string::npos;
   }
   return false;
+}
+
+// The nearest planned contact of a position (1-based point number).
+int nearestPlannedPoint(const parts::PlanManifest& m, int position, const Eigen::Vector3d& tip) {
+  const int per = m.pointsPerSphere();
+  int best = 1;
+  double d_best = 1e300;
+  for (int k = 1; k <= per; ++k) {
+    const double d = (m.points[static_cast<std::size_t>((position - 1) * per + (k - 1))].contact_mm - tip).norm();
+    if (d < d_best) d_best = d, best = k;
+  }
+  return best;
 }
 
 std::vector<ProbeRecord> fromCsv(const std::string& text, const std::string& file,
@@ -45,8 +58,11 @@ std::vector<ProbeRecord> fromCsv(const std::string& text, const std::string& fil
   const int c_cycle = need("cycle"), c_c = need("c_deg"), c_x = need("x_mm"), c_y = need("y_mm"),
             c_z = need("z_mm");
   const int c_time = t.column("time_s"), c_feat = t.column("feature"), c_pt = t.column("point");
+  const int per = m.pointsPerSphere();
+  const double contact_radius = m.sphere_radius_mm + m.tip_radius_mm;
   std::vector<ProbeRecord> out;
-  std::map<std::pair<int, int>, int> seen;  // (cycle, position) -> points so far
+  std::map<std::pair<int, int>, int> unlabelled;                      // (cycle, position) -> points so far
+  std::map<std::pair<int, double>, std::vector<std::string>> labels;  // (cycle, C) -> foreign labels met
   for (const auto& row : t.rows) {
     ProbeRecord r;
     r.file = file;
@@ -56,30 +72,58 @@ std::vector<ProbeRecord> fromCsv(const std::string& text, const std::string& fil
       throw InputError(file, row.line, "cycle must be a positive integer");
     r.cycle = static_cast<int>(cyc);
     const double c = t.number(row, c_c);
-    if (c_feat >= 0) {
-      const std::string& f = row.fields[c_feat];
-      for (const auto& s : m.spheres)
-        if (s.id == f) r.position = s.position;
-      if (r.position == 0)
-        throw InputError(file, row.line, "feature '" + f + "' is not in the manifest");
+    r.tip_mm = {t.number(row, c_x), t.number(row, c_y), t.number(row, c_z)};
+    const std::string label = c_feat >= 0 ? row.fields[static_cast<std::size_t>(c_feat)] : std::string();
+    bool trusted = false;  // a manifest id: its position, and its point numbers if given
+    for (const auto& s : m.spheres)
+      if (!label.empty() && s.id == label) {
+        r.position = s.position;
+        trusted = true;
+      }
+    if (trusted) {
       if (std::fabs(m.sphere(r.position)->c_deg - c) > 1e-6)
-        throw InputError(file, row.line, "c_deg " + formatNumber(c) + " does not match feature " + f);
+        throw InputError(file, row.line, "c_deg " + formatNumber(c) + " does not match feature " + label);
     } else {
+      std::vector<int> at_c;  // the positions planned at this C angle, in order
       for (const auto& s : m.spheres)
-        if (std::fabs(s.c_deg - c) < 1e-6) r.position = s.position;
-      if (r.position == 0)
+        if (std::fabs(s.c_deg - c) < 1e-6) at_c.push_back(s.position);
+      if (at_c.empty())
         throw InputError(file, row.line, "c_deg " + formatNumber(c) + " is not a planned C position");
+      std::size_t k = 0;
+      if (at_c.size() > 1) {
+        if (!label.empty()) {
+          auto& seen = labels[{r.cycle, c}];
+          const auto it = std::find(seen.begin(), seen.end(), label);
+          k = static_cast<std::size_t>(it - seen.begin());
+          if (it == seen.end()) seen.push_back(label);
+        } else {
+          // Without labels, by order: the planned number of points to each in turn.
+          int counted = 0;
+          for (std::size_t j = 0; j < at_c.size(); ++j) counted += unlabelled[{r.cycle, at_c[j]}];
+          k = static_cast<std::size_t>(counted / per);
+        }
+        if (k >= at_c.size())
+          throw InputError(file, row.line, "label '" + label + "' would be position " + std::to_string(k + 1) + " at c_deg " +
+                                               formatNumber(c) + ", where " + std::to_string(at_c.size()) + " are planned");
+      }
+      r.position = at_c[k];
+      ++unlabelled[{r.cycle, r.position}];
+      const auto* s = m.sphere(r.position);
+      const double off = std::fabs((r.tip_mm - s->nominal_centre_mm).norm() - contact_radius);
+      if (off > 5.0)
+        throw InputError(file, row.line, "point is " + formatNumber(off, 3) + " mm off the nominal sphere of position " +
+                                             std::to_string(r.position) + " (c_deg " + formatNumber(c) +
+                                             "): it fits no planned position");
     }
-    const int nth = ++seen[{r.cycle, r.position}];
-    if (c_pt >= 0) {
+    if (trusted && c_pt >= 0) {
       const double p = t.number(row, c_pt);
       if (p != std::round(p) || p < 1)
         throw InputError(file, row.line, "point must be a positive integer");
       r.point = static_cast<int>(p);
     } else {
-      r.point = nth;  // points in the planned order
+      r.point = nearestPlannedPoint(m, r.position, r.tip_mm);
+      r.nearest_point = true;
     }
-    r.tip_mm = {t.number(row, c_x), t.number(row, c_y), t.number(row, c_z)};
     if (c_time >= 0) r.time_s = t.number(row, c_time);
     out.push_back(r);
   }
@@ -120,6 +164,7 @@ std::vector<ProbeRecord> readProbeRecords(const std::string& path, PointsFormat 
       throw InputError(path, r.line, "position " + std::to_string(r.position) +
                                          " is not in the manifest (" +
                                          std::to_string(m.spheres.size()) + " positions)");
+    if (r.nearest_point) continue;  // checked against its nominal sphere when it was read
     if (r.point > per)
       throw InputError(path, r.line, "point " + std::to_string(r.point) + " of position " +
                                          std::to_string(r.position) + " is not planned (" +

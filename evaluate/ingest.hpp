@@ -1,7 +1,17 @@
 // Reading probed points from any of the three inputs into one list of records.
+//
+// A points CSV may come from any probing cycle (docs/formats.md#points-csv): its points in any
+// order and number, with the manifest's feature ids, foreign labels or none. A point whose label
+// is a manifest id takes that position (its c_deg must agree) and, with a `point` column, that
+// planned point. Any other point takes the position planned at its c_deg; positions that share a
+// C angle (repeats) are told apart by the label (the k-th label met at that C in a cycle is the
+// k-th such position) or, without labels, by order (the planned number of points each). It must
+// lie within 5 mm of that position's nominal sphere (radius + tip radius from the nominal
+// centre), and it is paired with its nearest planned contact, for the planned time only.
+//
 // Contract: every record names its source line; a line that cannot belong to the manifest
-// (unknown position or point, a point far from its planned probing line, a duplicate) is an
-// InputError with file:line. Nothing is guessed silently.
+// (a C angle not planned, a point that fits no position, a trusted point far from its planned
+// probing line or twice) is an InputError with file:line. Nothing is guessed silently.
 #pragma once
 #include <Eigen/Dense>
 #include <optional>
@@ -21,6 +31,9 @@ struct ProbeRecord {
   int cycle = 0, position = 0, point = 0;
   Eigen::Vector3d tip_mm = Eigen::Vector3d::Zero();
   std::optional<double> time_s;  // only the CSV carries times
+  // The point number is the nearest planned contact's (a point of another cycle's numbering, or
+  // none), not the file's: several records may share it.
+  bool nearest_point = false;
 };
 
 std::vector<ProbeRecord> readProbeRecords(const std::string& path, PointsFormat format,

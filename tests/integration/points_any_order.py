@@ -1,0 +1,104 @@
+#!/usr/bin/env python3
+"""Probe data from any cycle (issue 15 item 4): a sphere-artifact campaign's points.csv, written
+again as another probing cycle and a European spreadsheet would (the points shuffled within each
+position, foreign labels, no point numbers, a UTF-8 byte-order mark, CRLF, ';' separators,
+decimal commas), evaluates to the same errors.csv as the original, to the printed digit.
+Also: one point fewer per position still evaluates (n >= 4 with a known radius); a point moved
+off its sphere, a comma-separated file with decimal commas and a C angle not planned are refused
+naming file and line, and nothing is written.
+
+Needs $PROBELOOP and $PROBELOOP_SOURCE_DIR."""
+import csv, io, os, random, subprocess, sys, tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402
+
+PL = os.environ["PROBELOOP"]
+SRC = os.environ["PROBELOOP_SOURCE_DIR"]
+W = tempfile.mkdtemp(prefix="probeloop-anyorder-")
+check = Checks()
+
+
+def run(*args):
+    p = subprocess.run([PL, *args], capture_output=True, text=True)
+    return p.returncode, p.stdout, p.stderr
+
+
+code, _, err = run("plan", f"{SRC}/parts/sphere_artifact.yaml", "--machine", f"{SRC}/parts/machines/nmv5000.yaml", "--out", f"{W}/plan")
+check("plan", code == 0, err)
+code, _, err = run("simulate", f"{W}/plan/sphere_cycle.nc", "--machine", f"{SRC}/parts/machines/nmv5000.yaml", "--part",
+                   f"{SRC}/parts/sphere_artifact.yaml", "--truth", f"{SRC}/examples/truth_campaign.yaml", "--out", f"{W}/run", "--seed", "3")
+check("simulate", code == 0, err)
+lines = [l for l in open(f"{W}/run/points.csv") if not l.startswith("#")]
+rows = list(csv.DictReader(lines))
+header = list(rows[0].keys())
+
+
+def evaluate(points, out):
+    return run("evaluate", points, "--format", "csv", "--manifest", f"{W}/plan/plan.json", "--out", out)
+
+
+def numbers(errors_csv):
+    return [l for l in open(errors_csv) if not l.startswith("#")]
+
+
+code, _, err = evaluate(f"{W}/run/points.csv", f"{W}/ev0")
+check("evaluate the points as simulated", code == 0, err)
+
+# The same points as another cycle writes them.
+rng = random.Random(7)
+groups = {}
+for r in rows:
+    groups.setdefault((r["cycle"], r["feature"]), []).append(r)
+foreign = {f: f"Kugel {i}" for i, f in enumerate(sorted({r["feature"] for r in rows}), start=1)}
+cols = ["cycle", "c_deg", "feature", "time_s", "x_mm", "y_mm", "z_mm"]
+
+
+def european(rows_out):
+    text = "\ufeff" + ";".join(cols) + "\r\n"
+    for r in rows_out:
+        text += ";".join(r[c].replace(".", ",") if c != "feature" else foreign[r[c]] for c in cols) + "\r\n"
+    return text
+
+
+shuffled = []
+for key in sorted(groups, key=lambda k: (int(k[0]), k[1]), reverse=True):  # positions in another order too
+    g = groups[key][:]
+    rng.shuffle(g)
+    shuffled += g
+with open(f"{W}/eu.csv", "w", encoding="utf-8", newline="") as f:
+    f.write(european(shuffled))
+code, out, err = evaluate(f"{W}/eu.csv", f"{W}/ev1")
+check("the shuffled, relabelled, CRLF, ';' + decimal-comma file evaluates", code == 0, err)
+if code == 0:
+    a, b = numbers(f"{W}/ev0/errors.csv"), numbers(f"{W}/ev1/errors.csv")
+    check(f"... to the same errors.csv, every printed digit ({len(a) - 1} cycles)", a == b,
+          next((f"{x.strip()} | {y.strip()}" for x, y in zip(a, b) if x != y), "row count"))
+
+# One point fewer per position: still a sphere with its known radius.
+fewer = []
+for key in sorted(groups):
+    fewer += groups[key][1:]
+with open(f"{W}/fewer.csv", "w", newline="") as f:
+    f.write(",".join(cols) + "\n" + "".join(",".join(r[c] for c in cols) + "\n" for r in fewer))
+code, out, err = evaluate(f"{W}/fewer.csv", f"{W}/ev2")
+check("one point fewer per position evaluates", code == 0 and os.path.exists(f"{W}/ev2/errors.csv"), err)
+
+
+def refused(name, text, want):
+    path = f"{W}/{name}.csv"
+    with open(path, "w", newline="") as f:
+        f.write(text)
+    code, _, err = evaluate(path, f"{W}/bad-{name}")
+    check(f"{name}: refused with '{want}', nothing written", code != 0 and want in err and not os.path.exists(f"{W}/bad-{name}"), err)
+
+
+off = [dict(r) for r in shuffled]
+off[5]["x_mm"] = str(float(off[5]["x_mm"]) + 20.0)
+refused("off-sphere", european(off), "off-sphere.csv:7: point is")
+comma_text = ",".join(cols) + "\n" + "".join(",".join(r[c].replace(".", ",") if c != "feature" else r[c] for c in cols) + "\n" for r in rows)
+refused("comma-decimal", comma_text, "comma-decimal.csv:2: expected 7 fields")
+bad_c = [dict(r) for r in shuffled]
+bad_c[0]["c_deg"] = "17"
+refused("c-not-planned", european(bad_c), "c-not-planned.csv:2: c_deg 17 is not a planned C position")
+check.finish()
