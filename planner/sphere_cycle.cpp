@@ -30,7 +30,7 @@ bool sameAngle(double a, double b) {
 // would change its planned times and so the bytes of its plan.json and program header.
 class Walker {
  public:
-  Walker(const Machine& m, CycleTime& t) : m_(m), t_(t) {
+  Walker(const Machine& m, CycleTime& t) : m_(m), t_(&t) {
     gauge_ = Vector3d(0, 0, m.tool_change.z_mm);  // XY unknown at start: rapids from here
   }
 
@@ -39,7 +39,9 @@ class Walker {
   void run(const gcode::Op& op, const std::string& where) {
     std::visit([&](const auto& o) { step(o, where); }, op);
   }
-  double time() const { return t_.total(); }
+  double time() const { return t_->total(); }
+  // Where the time of the following ops goes (the ops before the loop, a cycle, …).
+  void account(CycleTime& t) { t_ = &t; }
   Vector3d tip() const { return gauge_ - Vector3d(0, 0, length_); }
 
  private:
@@ -59,7 +61,7 @@ class Walker {
   }
   void rapidTo(const Vector3d& g, const std::string& where, const std::string& what) {
     check(g, where, what);
-    t_.rapid_s += (g - gauge_).cwiseAbs().maxCoeff() / (m_.rapid_feed_mm_per_min / 60.0);
+    t_->rapid_s += (g - gauge_).cwiseAbs().maxCoeff() / (m_.rapid_feed_mm_per_min / 60.0);
     gauge_ = g;
   }
   void step(const gcode::Comment&, const std::string&) {}
@@ -76,24 +78,24 @@ class Walker {
   void step(const gcode::RotateC& r, const std::string& where) {
     if (!m_.c.continuous && (r.c_deg < m_.c.min_deg || r.c_deg > m_.c.max_deg))
       throw SafetyError(where + ": C = " + formatNumber(r.c_deg, 3) + " deg is outside the C travel");
-    t_.c_index_s += std::fabs(r.c_deg - c_) / (m_.c.max_speed_rpm * 6.0);
+    t_->c_index_s += std::fabs(r.c_deg - c_) / (m_.c.max_speed_rpm * 6.0);
     c_ = r.c_deg;
   }
   void step(const gcode::ToolChange& tc, const std::string&) {
-    t_.tool_change_s += m_.tool_change.time_s;
+    t_->tool_change_s += m_.tool_change.time_s;
     length_ = tc.apply_length_offset ? m_.probe.length_mm : 0.0;
   }
   void step(const gcode::ProtectedMove& p, const std::string& where) {
     const Vector3d g(p.x, p.y, p.z + length_);
     check(g, where, "protected move");
-    t_.protected_s += (g - gauge_).norm() / (p.feed_mm_per_min / 60.0);
+    t_->protected_s += (g - gauge_).norm() / (p.feed_mm_per_min / 60.0);
     gauge_ = g;
   }
   void step(const gcode::ProbeMove& p, const std::string& where) {
     // Timed to the nominal contact (set by the planner); the end is checked for travel.
     const Vector3d g(p.x, p.y, p.z + length_);
     check(g, where, "probing move end (overtravel)");
-    t_.probing_s += (contact_ + Vector3d(0, 0, length_) - gauge_).norm() / (p.feed_mm_per_min / 60.0);
+    t_->probing_s += (contact_ + Vector3d(0, 0, length_) - gauge_).norm() / (p.feed_mm_per_min / 60.0);
     gauge_ = contact_ + Vector3d(0, 0, length_);
   }
   void step(const gcode::Dwell&, const std::string&) {}  // no dwell inside a cycle
@@ -104,7 +106,7 @@ class Walker {
   }
 
   const Machine& m_;
-  CycleTime& t_;
+  CycleTime* t_;
   Vector3d gauge_;
   double length_ = 0.0;
   double c_ = 0.0;
@@ -179,14 +181,16 @@ SpherePlan planSphereCycle(const SphereArtifact& a, const Machine& m, const Plan
   prog.gap_s = a.gap_s;
 
   std::vector<gcode::Op>& body = prog.cycle_body;
+  std::vector<gcode::Op> before, after;
   std::vector<std::pair<gcode::Op, std::string>> timed;  // op + where, for the walker
   std::vector<int> contact_of;                            // manifest point index per op, -1
+  std::vector<int> part_of;                               // 0 before the loop, 1 the cycle, 2 after
   auto emit = [&](std::vector<gcode::Op>& into, gcode::Op op, const std::string& where, int pt = -1) {
     into.push_back(op);
     timed.emplace_back(op, where);
     contact_of.push_back(pt);
+    part_of.push_back(&into == &before ? 0 : &into == &body ? 1 : 2);
   };
-  std::vector<gcode::Op> before, after;
   auto& tc_in = a.tool_change_each_cycle ? body : before;
   emit(tc_in, gcode::RapidMachineZ{tc_z}, "probe in");
   emit(tc_in, gcode::ToolChange{m.probe.tool, true}, "probe in");
@@ -228,15 +232,29 @@ SpherePlan planSphereCycle(const SphereArtifact& a, const Machine& m, const Plan
   prog.before_cycles = before;
   prog.after_cycles = after;
 
-  // Time one cycle (with its tool changes, whether inside the loop or not: the thesis's 95 s
-  // includes both) and check every target.
-  Walker w(m, plan.cycle_time);
-  for (size_t i = 0; i < timed.size(); ++i) {
-    if (contact_of[i] >= 0) w.setNextContact(man.points[contact_of[i]].contact_mm);
-    w.run(timed[i].first, timed[i].second);
-    if (contact_of[i] >= 0) man.points[contact_of[i]].time_in_cycle_s = w.time();
-  }
-  const double T = plan.cycle_time.total();
+  // Time the ops before the loop, the first cycle, a later cycle (it starts by turning C back
+  // from the last position to the first) and the ops after the loop, checking every target.
+  // Tool changes count in a cycle only when they are in it (tool_change_each_cycle); the
+  // thesis's 95 s has two.
+  CycleTime before_t, first_t, after_t;
+  Walker w(m, before_t);
+  auto walk = [&](int part, bool record) {
+    for (size_t i = 0; i < timed.size(); ++i) {
+      if (part_of[i] != part) continue;
+      if (contact_of[i] >= 0) w.setNextContact(man.points[contact_of[i]].contact_mm);
+      w.run(timed[i].first, timed[i].second);
+      if (record && contact_of[i] >= 0) man.points[contact_of[i]].time_in_cycle_s = before_t.total() + w.time();
+    }
+  };
+  walk(0, false);
+  w.account(first_t);
+  walk(1, true);
+  w.account(plan.cycle_time);
+  walk(1, false);
+  w.account(after_t);
+  walk(2, false);
+  const double t_before = before_t.total(), T1 = first_t.total();
+  const double T = plan.cycle_time.total();  // a cycle after the first
 
   int cycles = a.cycle_count;
   if (cycles == 0) cycles = std::max(1, static_cast<int>(std::floor((a.duration_s - T) / (T + a.gap_s))) + 1);
@@ -268,7 +286,15 @@ SpherePlan planSphereCycle(const SphereArtifact& a, const Machine& m, const Plan
   man.cycles = cycles;
   man.gap_s = a.gap_s;
   man.cycle_time_s = T;
-  for (int i = 0; i < cycles; ++i) man.cycle_start_s.push_back(i * (T + a.gap_s));
+  // Each cycle's start on the clock its points' time_in_cycle_s count from (the first cycle's,
+  // which holds the ops before the loop and no C return): a later cycle's body starts after the
+  // previous one and its gap, and its points come T - T1 (the C return) later in it.
+  man.cycle_start_s.push_back(0.0);
+  double body_start = t_before + T1 + a.gap_s;
+  for (int i = 1; i < cycles; ++i) {
+    man.cycle_start_s.push_back(body_start + (T - T1) - t_before);
+    body_start += T + a.gap_s;
+  }
 
   prog.header = {
       "machine: " + m.name,

@@ -27,7 +27,7 @@ struct CycleTime {
 struct SpherePlan {
   gcode::ProbeProgram program;
   parts::PlanManifest manifest;
-  CycleTime cycle_time;
+  CycleTime cycle_time;  // a cycle after the first: its C return, its tool changes only if in the loop
 };
 
 struct PlanFiles {

@@ -101,10 +101,33 @@ TEST(SphereCycle, OutsideTravelIsRefusedWithTheMoveAndAxis) {
 }
 
 TEST(SphereCycle, CycleTimeIsTheSumOfItsMoves) {
-  // Independent arithmetic for the NMV 5000 defaults: 2 tool changes of 6 s; C moves of
-  // 0+90+90+90+90 deg at 16.66 rpm = 99.96 deg/s; 25 probing moves of 3 mm at 200 mm/min.
+  // Independent arithmetic for the NMV 5000 defaults, a cycle after the first: 2 tool changes
+  // of 6 s; C back from 360 to 0, then 90+90+90+90 deg, at 16.66 rpm = 99.96 deg/s; 25 probing
+  // moves of 3 mm at 200 mm/min.
   const auto t = planSphereCycle(artifact(), machine()).cycle_time;
   EXPECT_NEAR(t.tool_change_s, 12.0, 1e-12);
-  EXPECT_NEAR(t.c_index_s, 360.0 / 99.96, 1e-9);
+  EXPECT_NEAR(t.c_index_s, 720.0 / 99.96, 1e-9);
   EXPECT_NEAR(t.probing_s, 25 * 3.0 / (200.0 / 60.0), 1e-9);
+}
+
+// The schedule: each later cycle starts a cycle and a gap after the previous one, the cycle with
+// its C return; tool changes outside the loop are not in it, and the first cycle's points count
+// the probe-in change before them.
+TEST(SphereCycle, TheScheduleHoldsTheCReturnAndOnlyTheToolChangesThatHappen) {
+  auto a = artifact();
+  const auto in_loop = planSphereCycle(a, machine());
+  const auto& m1 = in_loop.manifest;
+  ASSERT_GE(m1.cycles, 3);
+  const double T1 = in_loop.cycle_time.total();
+  EXPECT_DOUBLE_EQ(m1.cycle_time_s, T1);
+  EXPECT_NEAR(m1.cycle_start_s[1] - m1.cycle_start_s[0], T1 + a.gap_s, 1e-9);
+  EXPECT_NEAR(m1.cycle_start_s[2] - m1.cycle_start_s[1], T1 + a.gap_s, 1e-9);
+  a.tool_change_each_cycle = false;
+  const auto outside = planSphereCycle(a, machine());
+  EXPECT_EQ(outside.cycle_time.tool_change_s, 0.0);
+  EXPECT_NEAR(outside.cycle_time.c_index_s, 720.0 / 99.96, 1e-9);
+  EXPECT_NEAR(outside.manifest.cycle_start_s[1], outside.cycle_time.total() + a.gap_s, 1e-9);
+  // The first point of the first cycle comes after the probe-in change (6 s), the first of a
+  // later cycle after the C return: both at cycle_start + time_in_cycle on one clock.
+  EXPECT_GT(outside.manifest.points[0].time_in_cycle_s, 6.0);
 }

@@ -3,7 +3,8 @@
 again as another probing cycle and a European spreadsheet would (the points shuffled within each
 position, foreign labels, no point numbers, a UTF-8 byte-order mark, CRLF, ';' separators,
 decimal commas), evaluates to the same errors.csv as the original, to the printed digit.
-Also: one point fewer per position still evaluates (n >= 4 with a known radius); a point moved
+Also: the plan's schedule (cycle starts + times in the cycle) within 1 s of the simulated clock
+over the campaign; one point fewer per position still evaluates (n >= 4 with a known radius); a point moved
 off its sphere, a comma-separated file with decimal commas and a C angle not planned are refused
 naming file and line, and nothing is written.
 
@@ -32,6 +33,18 @@ check("simulate", code == 0, err)
 lines = [l for l in open(f"{W}/run/points.csv") if not l.startswith("#")]
 rows = list(csv.DictReader(lines))
 header = list(rows[0].keys())
+
+
+# The plan's schedule against the simulated clock: every point's planned time (its cycle's start
+# + its time in the cycle) within 1 s of when the simulator's probe triggered, over all cycles
+# (the C return and the tool changes in the schedule; what remains is the probing moves meeting
+# the sphere where the errors put it).
+import json  # noqa: E402
+plan = json.load(open(f"{W}/plan/plan.json"))
+planned = {(p["feature"], p["point"]): p["time_in_cycle_s"] for p in plan["points"]}
+starts = plan["schedule"]["cycle_start_s"]
+drift = max(abs(float(r["time_s"]) - (starts[int(r["cycle"]) - 1] + planned[(r["feature"], int(r["point"]))])) for r in rows)
+check(f"the schedule follows the simulated clock: worst |planned - simulated| {drift:.3f} s over {len(starts)} cycles", drift < 1.0)
 
 
 def evaluate(points, out):
