@@ -40,10 +40,34 @@ int CsvTable::column(const std::string& name) const {
 }
 
 bool parseFiniteNumber(const std::string& text, double& value) {
-  if (text.empty()) return false;
+  if (text.empty() || text.find_first_not_of("0123456789+-.eE") != std::string::npos) return false;
   char* end = nullptr;
   value = std::strtod(text.c_str(), &end);
   return end == text.c_str() + text.size() && std::isfinite(value);
+}
+
+bool CsvTable::tryNumber(const CsvRow& row, int col, double& v) const {
+  if (col < 0 || col >= static_cast<int>(row.fields.size())) return false;
+  std::string f = row.fields[static_cast<std::size_t>(col)];
+  if (separator == ';' && f.find(',') != std::string::npos) {
+    if (f.find('.') != std::string::npos || f.find(',') != f.rfind(',')) return false;
+    f[f.find(',')] = '.';
+  }
+  return parseFiniteNumber(f, v);
+}
+
+std::vector<std::string> csvHeaderFields(const std::string& text) {
+  std::istringstream in(text);
+  std::string line;
+  for (int n = 1; std::getline(in, line); ++n) {
+    if (n == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    const std::string tl = trim(line);
+    if (tl.empty() || tl[0] == '#') continue;
+    const bool semi = tl.find(';') != std::string::npos, comma = tl.find(',') != std::string::npos;
+    return split(tl, semi && !comma ? ';' : ',');
+  }
+  return {};
 }
 
 double CsvTable::number(const CsvRow& row, int col) const {

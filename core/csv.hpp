@@ -30,10 +30,17 @@ struct CsvTable {
   // Parses fields[col] of a row as a finite double (a decimal comma in a ';' file);
   // InputError with file:line:column name.
   double number(const CsvRow& row, int col) const;
+  // The same rules without throwing: false for a missing or non-numeric field.
+  bool tryNumber(const CsvRow& row, int col, double& value) const;
 };
 
-// Parses the whole string as a finite double (no trailing characters, no NaN or inf).
+// Parses the whole string as a finite decimal double: sign, digits, one point, exponent (no
+// trailing characters, no hexadecimal, NaN or inf).
 bool parseFiniteNumber(const std::string& text, double& value);
+
+// A CSV text's header line split by its separator (the rules above), the byte-order mark and
+// comments skipped; empty when there is none. For readers that sniff a file's kind.
+std::vector<std::string> csvHeaderFields(const std::string& text);
 
 CsvTable parseCsv(const std::string& text, const std::string& file_name);
 

@@ -60,6 +60,15 @@ TEST(Csv, SemicolonFilesTakeDecimalCommasAndNothingIsMisread) {
     EXPECT_NE(std::string(e.what()).find("separate the columns with ';'"), std::string::npos) << e.what();
   }
   EXPECT_THROW(parseCsv("x_mm,y_mm;z_mm\n1,2;3\n", "mixed.csv"), std::exception);
+  // Only decimal numbers: strtod alone would take hexadecimal, inf and nan.
+  double v = 0;
+  EXPECT_FALSE(parseFiniteNumber("0x1.8", v));
+  EXPECT_FALSE(parseFiniteNumber("inf", v));
+  EXPECT_FALSE(parseFiniteNumber("nan", v));
+  EXPECT_TRUE(parseFiniteNumber("-1.5e-3", v));
+  EXPECT_DOUBLE_EQ(v, -1.5e-3);
+  // The header sniffed the same way by the readers that tell a file's kind by it.
+  EXPECT_EQ(csvHeaderFields("\xEF\xBB\xBF# exported\r\nfacet;g_um\r\n1;2,5\r\n"), (std::vector<std::string>{"facet", "g_um"}));
   // A comma file is read as before: a decimal comma can never get into a number there.
   const auto c = parseCsv("a,b\n1.5,2\n", "c.csv");
   EXPECT_EQ(c.separator, ',');

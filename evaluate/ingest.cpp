@@ -26,7 +26,8 @@ namespace {
 bool looksLikeCsv(const std::string& text) {
   std::istringstream in(text);
   for (std::string line; std::getline(in, line);) {
-    if (line.empty() || line[0] == '#') continue;
+    if (line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 byte-order mark
+    if (line.empty() || line[0] == '#' || line == "\r") continue;
     return line.find(',') != std::string::npos || line.find(';') != std::string::npos;
   }
   return false;
@@ -58,11 +59,12 @@ std::vector<ProbeRecord> fromCsv(const std::string& text, const std::string& fil
   const int c_cycle = need("cycle"), c_c = need("c_deg"), c_x = need("x_mm"), c_y = need("y_mm"),
             c_z = need("z_mm");
   const int c_time = t.column("time_s"), c_feat = t.column("feature"), c_pt = t.column("point");
-  const int per = m.pointsPerSphere();
   const double contact_radius = m.sphere_radius_mm + m.tip_radius_mm;
+  // First every row, so that a label's place among those at one C angle can be told by time.
   std::vector<ProbeRecord> out;
-  std::map<std::pair<int, int>, int> unlabelled;                      // (cycle, position) -> points so far
-  std::map<std::pair<int, double>, std::vector<std::string>> labels;  // (cycle, C) -> foreign labels met
+  std::vector<double> c_of;
+  std::vector<std::string> label_of;
+  std::set<std::pair<int, int>> claimed;  // (cycle, position) named by a manifest id
   for (const auto& row : t.rows) {
     ProbeRecord r;
     r.file = file;
@@ -73,59 +75,80 @@ std::vector<ProbeRecord> fromCsv(const std::string& text, const std::string& fil
     r.cycle = static_cast<int>(cyc);
     const double c = t.number(row, c_c);
     r.tip_mm = {t.number(row, c_x), t.number(row, c_y), t.number(row, c_z)};
+    if (c_time >= 0) r.time_s = t.number(row, c_time);
     const std::string label = c_feat >= 0 ? row.fields[static_cast<std::size_t>(c_feat)] : std::string();
-    bool trusted = false;  // a manifest id: its position, and its point numbers if given
     for (const auto& s : m.spheres)
-      if (!label.empty() && s.id == label) {
-        r.position = s.position;
-        trusted = true;
-      }
-    if (trusted) {
+      if (!label.empty() && s.id == label) r.position = s.position;
+    if (r.position != 0) {
       if (std::fabs(m.sphere(r.position)->c_deg - c) > 1e-6)
         throw InputError(file, row.line, "c_deg " + formatNumber(c) + " does not match feature " + label);
-    } else {
-      std::vector<int> at_c;  // the positions planned at this C angle, in order
+      claimed.insert({r.cycle, r.position});
+      if (c_pt >= 0) {
+        const double p = t.number(row, c_pt);
+        if (p != std::round(p) || p < 1)
+          throw InputError(file, row.line, "point must be a positive integer");
+        r.point = static_cast<int>(p);
+      }
+    }
+    out.push_back(r);
+    c_of.push_back(c);
+    label_of.push_back(label);
+  }
+  // Then the others: the position planned at their C angle, not named by an id in that cycle.
+  std::map<std::pair<int, double>, std::vector<std::pair<double, std::string>>> labels_at;  // (cycle, C) -> (first time, label)
+  for (std::size_t i = 0; i < out.size(); ++i)
+    if (out[i].position == 0 && !label_of[i].empty() && out[i].time_s) {
+      auto& v = labels_at[{out[i].cycle, c_of[i]}];
+      auto it = std::find_if(v.begin(), v.end(), [&](const auto& e) { return e.second == label_of[i]; });
+      if (it == v.end()) v.emplace_back(*out[i].time_s, label_of[i]);
+      else it->first = std::min(it->first, *out[i].time_s);
+    }
+  for (auto& [key, v] : labels_at) std::sort(v.begin(), v.end());
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    ProbeRecord& r = out[i];
+    if (r.position == 0) {
+      const double c = c_of[i];
+      std::vector<int> at_c, planned_at_c;  // the positions planned at this C angle, in order
       for (const auto& s : m.spheres)
-        if (std::fabs(s.c_deg - c) < 1e-6) at_c.push_back(s.position);
+        if (std::fabs(s.c_deg - c) < 1e-6) {
+          planned_at_c.push_back(s.position);
+          if (!claimed.count({r.cycle, s.position})) at_c.push_back(s.position);
+        }
+      if (planned_at_c.empty())
+        throw InputError(file, r.line, "c_deg " + formatNumber(c) + " is not a planned C position");
       if (at_c.empty())
-        throw InputError(file, row.line, "c_deg " + formatNumber(c) + " is not a planned C position");
+        throw InputError(file, r.line, "label '" + label_of[i] + "' at c_deg " + formatNumber(c) +
+                                           ": the positions planned there are named by the manifest's ids in this cycle");
       std::size_t k = 0;
       if (at_c.size() > 1) {
-        if (!label.empty()) {
-          auto& seen = labels[{r.cycle, c}];
-          const auto it = std::find(seen.begin(), seen.end(), label);
-          k = static_cast<std::size_t>(it - seen.begin());
-          if (it == seen.end()) seen.push_back(label);
-        } else {
-          // Without labels, by order: the planned number of points to each in turn.
-          int counted = 0;
-          for (std::size_t j = 0; j < at_c.size(); ++j) counted += unlabelled[{r.cycle, at_c[j]}];
-          k = static_cast<std::size_t>(counted / per);
-        }
+        // Repeats at one C angle are the same sphere in the same place: only a label per
+        // position and the time tell them apart (the earlier label is the earlier position).
+        std::string ids;
+        for (int p : at_c) ids += (ids.empty() ? "" : ", ") + std::to_string(p);
+        if (label_of[i].empty() || !r.time_s)
+          throw InputError(file, r.line, "c_deg " + formatNumber(c) + " holds positions " + ids +
+                                             ": a point there needs the manifest's feature id, or a label per position and time_s");
+        const auto& v = labels_at.at({r.cycle, c});
+        k = static_cast<std::size_t>(std::find_if(v.begin(), v.end(), [&](const auto& e) { return e.second == label_of[i]; }) - v.begin());
         if (k >= at_c.size())
-          throw InputError(file, row.line, "label '" + label + "' would be position " + std::to_string(k + 1) + " at c_deg " +
-                                               formatNumber(c) + ", where " + std::to_string(at_c.size()) + " are planned");
+          throw InputError(file, r.line, "label '" + label_of[i] + "' is the " + std::to_string(k + 1) + "th at c_deg " +
+                                             formatNumber(c) + " in cycle " + std::to_string(r.cycle) + ", where " +
+                                             std::to_string(at_c.size()) + " positions are planned");
       }
       r.position = at_c[k];
-      ++unlabelled[{r.cycle, r.position}];
+    }
+    if (r.point == 0) {
+      // Not a planned point number: on the position's nominal sphere, paired with the nearest
+      // planned contact (for its planned time).
       const auto* s = m.sphere(r.position);
       const double off = std::fabs((r.tip_mm - s->nominal_centre_mm).norm() - contact_radius);
       if (off > 5.0)
-        throw InputError(file, row.line, "point is " + formatNumber(off, 3) + " mm off the nominal sphere of position " +
-                                             std::to_string(r.position) + " (c_deg " + formatNumber(c) +
-                                             "): it fits no planned position");
-    }
-    if (trusted && c_pt >= 0) {
-      const double p = t.number(row, c_pt);
-      if (p != std::round(p) || p < 1)
-        throw InputError(file, row.line, "point must be a positive integer");
-      r.point = static_cast<int>(p);
-    } else {
+        throw InputError(file, r.line, "point is " + formatNumber(off, 3) + " mm off the nominal sphere of position " +
+                                           std::to_string(r.position) + " (c_deg " + formatNumber(c_of[i]) +
+                                           "): it fits no planned position");
       r.point = nearestPlannedPoint(m, r.position, r.tip_mm);
       r.nearest_point = true;
     }
-    if (c_time >= 0) r.time_s = t.number(row, c_time);
-    out.push_back(r);
   }
   return out;
 }

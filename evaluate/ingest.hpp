@@ -3,11 +3,11 @@
 // A points CSV may come from any probing cycle (docs/formats.md#points-csv): its points in any
 // order and number, with the manifest's feature ids, foreign labels or none. A point whose label
 // is a manifest id takes that position (its c_deg must agree) and, with a `point` column, that
-// planned point. Any other point takes the position planned at its c_deg; positions that share a
-// C angle (repeats) are told apart by the label (the k-th label met at that C in a cycle is the
-// k-th such position) or, without labels, by order (the planned number of points each). It must
-// lie within 5 mm of that position's nominal sphere (radius + tip radius from the nominal
-// centre), and it is paired with its nearest planned contact, for the planned time only.
+// planned point. Any other point takes the position planned at its c_deg and not named by an id
+// in its cycle; positions that share a C angle (repeats: the same sphere in the same place) need
+// a label per position and time_s (the label seen first is the earlier position). A point without
+// a planned number must lie within 5 mm of its position's nominal sphere (radius + tip radius
+// from the nominal centre) and is paired with its nearest planned contact, for its planned time.
 //
 // Contract: every record names its source line; a line that cannot belong to the manifest
 // (a C angle not planned, a point that fits no position, a trusted point far from its planned

@@ -40,6 +40,7 @@ bool csvExtension(const std::string& path) {
 std::string firstDataLine(const std::string& text) {
   std::istringstream in(text);
   for (std::string line; std::getline(in, line);) {
+    if (line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 byte-order mark
     if (!line.empty() && line.back() == '\r') line.pop_back();
     const auto a = line.find_first_not_of(" \t");
     if (a == std::string::npos || line[a] == '#') continue;
@@ -48,15 +49,6 @@ std::string firstDataLine(const std::string& text) {
   return "";
 }
 
-std::vector<std::string> headerFields(const std::string& line) {
-  std::vector<std::string> out;
-  std::stringstream in(line);
-  for (std::string f; std::getline(in, f, ',');) {
-    const auto a = f.find_first_not_of(" \t"), b = f.find_last_not_of(" \t");
-    out.push_back(a == std::string::npos ? "" : f.substr(a, b - a + 1));
-  }
-  return out;
-}
 
 bool has(const std::vector<std::string>& h, const std::string& name) {
   return std::find(h.begin(), h.end(), name) != h.end();
@@ -128,9 +120,9 @@ Vector3d partToMachine(const parts::PlanManifest& m, const Vector3d& p, double c
 
 std::string detectTtpFormat(const std::string& path, const std::string& text) {
   const std::string first = firstDataLine(text);
-  const bool csv = first.find(',') != std::string::npos || csvExtension(path);
+  const bool csv = first.find(',') != std::string::npos || first.find(';') != std::string::npos || csvExtension(path);
   if (!csv) return "log";  // a PT log: LinuxCNC LOG and Fanuc DPRNT lines parse alike
-  const auto h = headerFields(first);
+  const auto h = csvHeaderFields(text);
   if (has(h, "g_um")) return "gauge";
   if (has(h, "c_deg") || has(h, "time_s")) return "csv";
   return "cmm";

@@ -207,9 +207,9 @@ RTest readRTest(const std::string& text_in, const std::string& file, const TtpRe
   return r;
 }
 
-std::optional<double> cell(const CsvRow& row, int col) {
+std::optional<double> cell(const CsvTable& t, const CsvRow& row, int col) {
   double v = 0;
-  if (col < 0 || col >= static_cast<int>(row.fields.size()) || !parseFiniteNumber(row.fields[col], v)) return std::nullopt;
+  if (!t.tryNumber(row, col, v)) return std::nullopt;
   return v;
 }
 
@@ -239,9 +239,9 @@ RTestChannel rTestChannel(const RTest& r, const char* column, RTestScale scale) 
   };
   std::vector<P> points;
   for (std::size_t i = 0; i < r.table.rows.size(); ++i) {
-    const auto v = cell(r.table.rows[i], col);
+    const auto v = cell(r.table, r.table.rows[i], col);
     if (!v) continue;
-    points.push_back({r.time_s[i], *v, cell(r.table.rows[i], uc), cell(r.table.rows[i], cc)});
+    points.push_back({r.time_s[i], *v, cell(r.table, r.table.rows[i], uc), cell(r.table, r.table.rows[i], cc)});
   }
   std::stable_sort(points.begin(), points.end(), [](const P& a, const P& b) { return a.t < b.t; });
   if (r.t0 && !points.empty() && *r.t0 >= points.front().t && *r.t0 <= points.back().t) {

@@ -48,9 +48,8 @@ rm -rf "$OUT/plan" "$OUT/run" "$OUT/eval"
   --out "$OUT/run" --seed "$SEED" > /dev/null
 # Evaluate the canonical points (the same reported coordinates as dprnt.txt, plus each
 # trigger's time), not the DPRNT log: a log carries no times, so its errors.csv would be
-# stamped with the plan's schedule, which runs 2.5 s per cycle short of the simulated clock
-# (the C return from 360 to 0 between cycles is not in the plan's cycle time; 17 min over
-# 48 h) and, with tool_change_each_cycle: false, 9.5 s long (both tool changes counted in
-# every cycle; 65 min over 48 h). A lag or a transient needs the errors on the inputs' clock.
+# stamped with the plan's schedule, which follows the simulated clock to about 0.07 s per
+# cycle (docs/sphere-cycle.md: probing moves meet the sphere where the errors put it), some
+# 30 s over 48 h. A lag or a transient needs the errors on the inputs' clock.
 "$PL" evaluate "$OUT/run/points.csv" --format csv --manifest "$OUT/plan/plan.json" --out "$OUT/eval" > /dev/null
 echo "$NAME (seed $SEED): $OUT/run/inputs.csv, $OUT/eval/errors.csv, $OUT/run/truth.json"

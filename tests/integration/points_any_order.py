@@ -88,6 +88,24 @@ if code == 0:
     check(f"... to the same errors.csv, every printed digit ({len(a) - 1} cycles)", a == b,
           next((f"{x.strip()} | {y.strip()}" for x, y in zip(a, b) if x != y), "row count"))
 
+# Without times, the planned schedule stamps the points (each paired with its nearest planned
+# contact): the shuffled file and the original, both without time_s, agree.
+def without_time(rows_in, sep=","):
+    cs = [c for c in cols if c != "time_s"]
+    return sep.join(cs) + "\n" + "".join(sep.join(r[c] for c in cs) + "\n" for r in rows_in)
+
+
+orig_nt = [r for r in rows]
+with open(f"{W}/nt0.csv", "w") as f:
+    f.write(without_time(orig_nt).replace("feature", "feature", 1))
+nt1 = [dict(r, feature=foreign[r["feature"]]) for r in shuffled]
+with open(f"{W}/nt1.csv", "w") as f:
+    f.write(without_time(nt1))
+c0, _, e0 = evaluate(f"{W}/nt0.csv", f"{W}/ev-nt0")
+c1, _, e1 = evaluate(f"{W}/nt1.csv", f"{W}/ev-nt1")
+check("without time_s, shuffled and relabelled, the same errors.csv as the original without time_s",
+      c0 == 0 and c1 == 0 and numbers(f"{W}/ev-nt0/errors.csv") == numbers(f"{W}/ev-nt1/errors.csv"), e0 + e1)
+
 # One point fewer per position: still a sphere with its known radius.
 fewer = []
 for key in sorted(groups):
@@ -111,7 +129,50 @@ off[5]["x_mm"] = str(float(off[5]["x_mm"]) + 20.0)
 refused("off-sphere", european(off), "off-sphere.csv:7: point is")
 comma_text = ",".join(cols) + "\n" + "".join(",".join(r[c].replace(".", ",") if c != "feature" else r[c] for c in cols) + "\n" for r in rows)
 refused("comma-decimal", comma_text, "comma-decimal.csv:2: expected 7 fields")
+moved = [dict(r) for r in rows]
+moved[3]["x_mm"] = str(float(moved[3]["x_mm"]) + 30.0)
+refused("id-moved", ",".join(["cycle", "c_deg", "feature", "x_mm", "y_mm", "z_mm"]) + "\n" +
+        "".join(",".join(r[c] for c in ["cycle", "c_deg", "feature", "x_mm", "y_mm", "z_mm"]) + "\n" for r in moved),
+        "id-moved.csv:5: point is")
 bad_c = [dict(r) for r in shuffled]
 bad_c[0]["c_deg"] = "17"
 refused("c-not-planned", european(bad_c), "c-not-planned.csv:2: c_deg 17 is not a planned C position")
+
+# Repeats at one C angle (c_positions 0, 90, 180, 270, 0: positions 1 and 5 are the same sphere in
+# the same place): foreign labels with times tell them apart, in any order; without labels the
+# points are refused with the reason.
+art = open(f"{SRC}/parts/sphere_artifact.yaml").read()
+import re  # noqa: E402
+art2 = re.sub(r"c_positions: \[[^]]*\]", "c_positions: [0, 90, 180, 270, 0]", art)
+check("an artifact with a repeated C position", art2 != art)
+with open(f"{W}/repeat.yaml", "w") as f:
+    f.write(art2)
+code, _, err = run("plan", f"{W}/repeat.yaml", "--machine", f"{SRC}/parts/machines/nmv5000.yaml", "--out", f"{W}/rplan")
+check("plan with a repeated C", code == 0, err)
+code, _, err = run("simulate", f"{W}/rplan/sphere_cycle.nc", "--machine", f"{SRC}/parts/machines/nmv5000.yaml", "--part",
+                   f"{W}/repeat.yaml", "--truth", f"{SRC}/examples/truth_campaign.yaml", "--out", f"{W}/rrun", "--seed", "4")
+check("simulate with a repeated C", code == 0, err)
+if code == 0:
+    rrows = list(csv.DictReader(l for l in open(f"{W}/rrun/points.csv") if not l.startswith("#")))
+    code, _, err = run("evaluate", f"{W}/rrun/points.csv", "--format", "csv", "--manifest", f"{W}/rplan/plan.json", "--out", f"{W}/rev0")
+    check("evaluate the repeated-C points as simulated", code == 0, err)
+    rg = {}
+    for r in rrows:
+        rg.setdefault((r["cycle"], r["feature"]), []).append(r)
+    rsh = []
+    for key in sorted(rg, key=lambda k: (int(k[0]), k[1]), reverse=True):
+        g = rg[key][:]
+        rng.shuffle(g)
+        rsh += g
+    lab = {f: f"Q{9 - i}" for i, f in enumerate(sorted({r["feature"] for r in rrows}))}
+    with open(f"{W}/rep.csv", "w") as f:
+        f.write(",".join(cols) + "\n" + "".join(",".join(r[c] if c != "feature" else lab[r[c]] for c in cols) + "\n" for r in rsh))
+    code, _, err = run("evaluate", f"{W}/rep.csv", "--format", "csv", "--manifest", f"{W}/rplan/plan.json", "--out", f"{W}/rev1")
+    check("repeated C, shuffled, foreign labels with times: the same errors.csv",
+          code == 0 and numbers(f"{W}/rev0/errors.csv") == numbers(f"{W}/rev1/errors.csv"), err)
+    with open(f"{W}/rep-nolabel.csv", "w") as f:
+        cs = ["cycle", "c_deg", "time_s", "x_mm", "y_mm", "z_mm"]
+        f.write(",".join(cs) + "\n" + "".join(",".join(r[c] for c in cs) + "\n" for r in rrows))
+    code, _, err = run("evaluate", f"{W}/rep-nolabel.csv", "--format", "csv", "--manifest", f"{W}/rplan/plan.json", "--out", f"{W}/rev2")
+    check("repeated C without labels: refused with the reason", code != 0 and "holds positions 1, 5" in err and not os.path.exists(f"{W}/rev2"), err)
 check.finish()
