@@ -172,6 +172,7 @@ std::vector<ProbeRecord> readProbeRecords(const std::string& path, PointsFormat 
       r.position = p.position;
       r.point = p.point;
       r.tip_mm = p.tip_mm;
+      r.time_s = p.time_s;  // Fanuc's clock in the log, when it is there
       out.push_back(r);
     }
   }

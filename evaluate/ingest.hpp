@@ -30,7 +30,7 @@ struct ProbeRecord {
   int line = 0;
   int cycle = 0, position = 0, point = 0;
   Eigen::Vector3d tip_mm = Eigen::Vector3d::Zero();
-  std::optional<double> time_s;  // only the CSV carries times
+  std::optional<double> time_s;  // the CSV's time_s, or the Fanuc log's clock (to the second)
   // The point number is the nearest planned contact's (a point of another cycle's numbering, or
   // none), not the file's: several records may share it.
   bool nearest_point = false;

@@ -208,7 +208,25 @@ class Execution {
       if (it == in_.named_.end()) fail("named parameter #<" + name + "> is read before it is set");
       return it->second;
     }
-    return in_.parameter(paramNumber(c));
+    return paramValue(paramNumber(c));
+  }
+
+  // A numbered parameter; Fanuc's #3011 (date YYYYMMDD) and #3012 (time HHMMSS) read the
+  // controller's clock.
+  double paramValue(int n) {
+    if (in_.dialect_ != ProgramDialect::FanucMacroB || (n != 3011 && n != 3012)) return in_.parameter(n);
+    const double s = std::max(0.0, m_.controllerClockS());
+    const long days = static_cast<long>(std::floor(s / 86400.0));
+    const long sec = static_cast<long>(std::floor(s - 86400.0 * static_cast<double>(days)));
+    if (n == 3012) return static_cast<double>(sec / 3600 * 10000 + sec % 3600 / 60 * 100 + sec % 60);
+    // Civil date from days since 2026-01-01 (H. Hinnant's days_from_civil, inverted).
+    long z = days + 20454 + 719468;  // 2026-01-01 is day 20454 since 1970-01-01
+    const long era = z / 146097, doe = z - era * 146097;
+    const long yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
+    const long doy = doe - (365 * yoe + yoe / 4 - yoe / 100), mp = (5 * doy + 2) / 153;
+    const long d = doy - (153 * mp + 2) / 5 + 1, m = mp < 10 ? mp + 3 : mp - 9;
+    const long y = yoe + era * 400 + (m <= 2 ? 1 : 0);
+    return static_cast<double>(y * 10000 + m * 100 + d);
   }
 
   int paramNumber(Cursor& c) {
@@ -598,7 +616,7 @@ class Execution {
       if (c.take("*")) {
         out += ' ';
       } else if (c.take("#")) {
-        const double v = in_.parameter(paramNumber(c));
+        const double v = paramValue(paramNumber(c));
         if (!c.take("[")) fail("DPRNT #i needs a format [ab]");
         const std::size_t close = body.find(']', c.i);
         if (close == std::string::npos || close - c.i != 2) fail("DPRNT format must be [ab], two digits");

@@ -59,6 +59,9 @@ class MachineInterface {
   virtual MachinePosition start() const { return {}; }
   // The program line about to execute (for traces).
   virtual void atLine(int /*line*/) {}
+  // The controller's clock: seconds since 2026-01-01 00:00 (Fanuc reads it as #3011, the date
+  // YYYYMMDD, and #3012, the time HHMMSS; LinuxCNC has no clock a program can read).
+  virtual double controllerClockS() const { return 0.0; }
 };
 
 struct InterpreterResult {

@@ -13,6 +13,8 @@ namespace {
 
 // Records every call; probes touch a plane x = contact_x (moving in +X) when set.
 struct Recorder : MachineInterface {
+  double clock_s = 0;  // the controller's clock (#3011/#3012)
+  double controllerClockS() const override { return clock_s; }
   std::vector<std::string> calls;
   std::vector<MachinePosition> targets;
   std::vector<std::string> log_lines;
@@ -148,13 +150,16 @@ TEST(Interpreter, FanucProgramWithSkipAlarmsAndDprnt) {
   p.cycle_body = {ToolChange{99, true}, Rapid{10.0, 0.0, 20.0}, ProbeMove{30, 0, 20, 200, 2, 4}};
   Recorder r;
   r.contact_x = 12.5;
+  r.clock_s = 3 * 86400.0 + 7 * 3600 + 15 * 60 + 30.9;  // 2026-01-04 07:15:30.9
   Interpreter in(ProgramDialect::FanucMacroB, "t.nc", writeFanucMacroB(p));
   in.run(r);
-  ASSERT_EQ(r.log_lines.size(), 5u);  // % + 3 points + %
+  ASSERT_EQ(r.log_lines.size(), 6u);  // % + START + 3 points + %
   EXPECT_EQ(r.log_lines.front(), "%");
-  // '*' prints a space, #i[ab] a sign column, a integer and b decimal digits.
-  EXPECT_EQ(r.log_lines[1], "PT     1 2 4    12.5000     0.0000    20.0000");
-  EXPECT_EQ(r.log_lines[3], "PT     3 2 4    12.5000     0.0000    20.0000");
+  // '*' prints a space, #i[ab] a sign column, a integer and b decimal digits; #3011 the date
+  // YYYYMMDD and #3012 the time HHMMSS (whole seconds) of the controller's clock.
+  EXPECT_EQ(r.log_lines[1], "START  20260104   71530");
+  EXPECT_EQ(r.log_lines[2], "PT     1 2 4    12.5000     0.0000    20.0000  20260104   71530");
+  EXPECT_EQ(r.log_lines[4], "PT     3 2 4    12.5000     0.0000    20.0000  20260104   71530");
 
   // Without contact the program's own check raises alarm #3000=1 at its line.
   Recorder none;

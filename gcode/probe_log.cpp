@@ -8,8 +8,31 @@
 #include "core/error.hpp"
 
 namespace probeloop::gcode {
+namespace {
+
+// Seconds since 1970-01-01 of a Fanuc date YYYYMMDD and time HHMMSS (H. Hinnant's days_from_civil).
+double clockSeconds(const std::string& date, const std::string& time, const std::string& file, int line) {
+  double dv = 0, tv = 0;
+  if (!parseFiniteNumber(date, dv) || !parseFiniteNumber(time, tv) || dv != std::round(dv) || tv != std::round(tv) || dv < 19000101 ||
+      dv > 99991231 || tv < 0 || tv > 235959)
+    throw InputError(file, line, "clock '" + date + " " + time + "': expected the date YYYYMMDD and the time HHMMSS (#3011, #3012)");
+  const long d = static_cast<long>(dv), t = static_cast<long>(tv);
+  long y = d / 10000;
+  const long m = d / 100 % 100, day = d % 100, hh = t / 10000, mm = t / 100 % 100, ss = t % 100;
+  if (m < 1 || m > 12 || day < 1 || day > 31 || mm > 59 || ss > 59)
+    throw InputError(file, line, "clock '" + date + " " + time + "': not a date and a time of day");
+  y -= m <= 2 ? 1 : 0;
+  const long era = (y >= 0 ? y : y - 399) / 400, yoe = y - era * 400;
+  const long doy = (153 * (m > 2 ? m - 3 : m + 9) + 2) / 5 + day - 1, doe = yoe * 365 + yoe / 4 - yoe / 100 + doy;
+  const long days = era * 146097 + doe - 719468;
+  return static_cast<double>(days) * 86400.0 + static_cast<double>(hh * 3600 + mm * 60 + ss);
+}
+
+}  // namespace
+
 std::vector<LoggedProbePoint> parseProbeLog(const std::string& text, const std::string& file) {
   std::vector<LoggedProbePoint> out;
+  std::optional<double> start;  // the first START line's clock
   std::istringstream in(text);
   std::string line;
   int n = 0;
@@ -27,10 +50,15 @@ std::vector<LoggedProbePoint> parseProbeLog(const std::string& text, const std::
       }
     }
     if (tok.empty() || (tok.size() == 1 && tok[0] == "%")) continue;
-    if (tok[0] != "PT" || tok.size() != 7) {
+    if (tok[0] == "START" && tok.size() == 3) {
+      const double s = clockSeconds(tok[1], tok[2], file, n);
+      if (!start) start = s;
+      continue;
+    }
+    if (tok[0] != "PT" || (tok.size() != 7 && tok.size() != 9)) {
       throw InputError(file, n,
                        "unrecognised log line '" + line +
-                           "'; expected 'PT <cycle> <position> <point> <x> <y> <z>'");
+                           "'; expected 'PT <cycle> <position> <point> <x> <y> <z> [<date> <time>]' or 'START <date> <time>'");
     }
     double v[6];
     for (int i = 0; i < 6; ++i) {
@@ -49,6 +77,7 @@ std::vector<LoggedProbePoint> parseProbeLog(const std::string& text, const std::
     p.position = static_cast<int>(v[1]);
     p.point = static_cast<int>(v[2]);
     p.tip_mm = Eigen::Vector3d(v[3], v[4], v[5]);
+    if (tok.size() == 9 && start) p.time_s = clockSeconds(tok[7], tok[8], file, n) - *start;
     out.push_back(p);
   }
   return out;

@@ -33,3 +33,21 @@ TEST(ProbeLog, ForeignLineNamesFileAndLine) {
   EXPECT_THROW(parseProbeLog("PT 1 1 1 0 nan 0\n", "d.log"), InputError);
   EXPECT_THROW(parseProbeLog("PT 1.5 1 1 0 0 0\n", "e.log"), InputError);
 }
+
+// Fanuc's clock: each PT line's date and time minus the first START's, across midnight and a
+// month's end (2026-01-31 23:59:58 -> 2026-02-01 00:00:03 is 5 s); LinuxCNC lines carry none.
+TEST(ProbeLog, FanucClockGivesEachPointItsTimeSinceTheFirstStart) {
+  const auto p = parseProbeLog("%\nSTART  20260131  235958\nPT     1 2 5  - 160.0010   18.0000  93.0020  20260131  235959\n"
+                               "START  20260201       2\nPT     1 2 6  - 160.0010   18.0000  93.0020  20260201       3\n"
+                               "PT 2.000000 3 1 -141.000000 0.500000 75.000000\n%\n", "d.txt");
+  ASSERT_EQ(p.size(), 3u);
+  EXPECT_DOUBLE_EQ(*p[0].time_s, 1.0);
+  EXPECT_DOUBLE_EQ(*p[1].time_s, 5.0);  // from the first START, not the second program's
+  EXPECT_FALSE(p[2].time_s.has_value());
+  try {
+    parseProbeLog("START 20261301 000000\n", "e.txt");
+    FAIL() << "month 13 was read";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("e.txt:1: clock '20261301 000000'"), std::string::npos) << e.what();
+  }
+}

@@ -154,8 +154,10 @@ struct FanucWriter {
           out << "G31" << xyz(m.x, m.y, m.z) << " F" << n3(m.feed_mm_per_min) << "\n";
           out << "IF [[ABS[#5061-" << macroConst(m.x) << "]+ABS[#5062-" << macroConst(m.y)
               << "]+ABS[#5063-" << macroConst(m.z) << "]] LT 0.0005] THEN #3000=1 (PROBE DID NOT TRIGGER)\n";
+          // The controller's clock with every point (#3011 date, #3012 time, 1 s): the log
+          // carries its own times (gcode/probe_log.hpp).
           out << "DPRNT[PT*#100[40]*" << m.position << "*" << m.point
-              << "*#5061[44]*#5062[44]*#5063[44]]\n";
+              << "*#5061[44]*#5062[44]*#5063[44]*#3011[80]*#3012[60]]\n";
         },
         [&](const Dwell& d) { out << "G4 X" << n3(d.seconds) << "\n"; },
         [&](const RotateB& r) { out << rotateBLine(r); },
@@ -263,6 +265,7 @@ std::string writeFanucMacroB(const Program& p) {
   o << wcs(p.work_offset) << "\n";
   if (!p.log_file.empty()) {
     o << "POPEN\n";
+    o << "DPRNT[START*#3011[80]*#3012[60]]\n";  // the clock when the program starts
     o << "#100=1\n";
   }
   for (const auto& op : p.ops) w.op(op);
@@ -306,6 +309,7 @@ std::string writeFanucMacroB(const ProbeProgram& p, int program_number) {
   o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_b_axis) << "\n";
   o << wcs(p.work_offset) << "\n";
   o << "POPEN\n";
+  o << "DPRNT[START*#3011[80]*#3012[60]]\n";  // the clock when the program starts
   for (const auto& op : p.before_cycles) w.op(op);
   o << "#100=1\n";
   o << "WHILE [#100 LE " << p.cycles << "] DO1\n";

@@ -582,7 +582,7 @@ struct ClockMachine : gcode::MachineInterface {
   void coolant(bool) override {}
   void openLog(const std::string&) override {}
   void log(const std::string& l) override {
-    if (l != "%") logs.push_back(l);
+    if (l != "%" && l.rfind("START ", 0) != 0) logs.push_back(l);  // Fanuc's START: the clock at the program's start
   }
   void closeLog() override {}
 };

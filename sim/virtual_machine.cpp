@@ -121,6 +121,9 @@ class VirtualMachine : public gcode::MachineInterface {
   }
 
   MachinePosition start() const override { return pos_; }
+  // The controller's clock (Fanuc #3011/#3012): Monday 2026-01-05 at the truth's start_clock
+  // (the hall's time of day at t = 0; midnight without one), then the simulated time.
+  double controllerClockS() const override { return 4 * 86400.0 + tr_.thermal.environment.start_clock_s + t_; }
   void atLine(int line) override { line_ = line; }
 
   // --- gcode::MachineInterface ---------------------------------------------------------

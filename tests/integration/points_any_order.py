@@ -3,7 +3,8 @@
 again as another probing cycle and a European spreadsheet would (the points shuffled within each
 position, foreign labels, no point numbers, a UTF-8 byte-order mark, CRLF, ';' separators,
 decimal commas), evaluates to the same errors.csv as the original, to the printed digit.
-Also: the plan's schedule (cycle starts + times in the cycle) within 1 s of the simulated clock
+Also: the Fanuc DPRNT log's clock (#3011/#3012) stamps each cycle within 1 s of the simulated
+triggers; the plan's schedule (cycle starts + times in the cycle) within 1 s of the simulated clock
 over the campaign; one point fewer per position still evaluates (n >= 4 with a known radius); a point moved
 off its sphere, a comma-separated file with decimal commas and a C angle not planned are refused
 naming file and line, and nothing is written.
@@ -87,6 +88,18 @@ if code == 0:
     a, b = numbers(f"{W}/ev0/errors.csv"), numbers(f"{W}/ev1/errors.csv")
     check(f"... to the same errors.csv, every printed digit ({len(a) - 1} cycles)", a == b,
           next((f"{x.strip()} | {y.strip()}" for x, y in zip(a, b) if x != y), "row count"))
+
+# The Fanuc log carries the controller's clock (#3011/#3012 with every point, START when the
+# program starts): evaluated from dprnt.txt, each cycle's time agrees with the one from the
+# simulator's own trigger times within 1 s.
+code, _, err = run("evaluate", f"{W}/run/dprnt.txt", "--format", "fanuc", "--manifest", f"{W}/plan/plan.json", "--out", f"{W}/ev-dprnt")
+check("evaluate the DPRNT log", code == 0, err)
+if code == 0:
+    t_log = [float(l.split(",")[0]) for l in numbers(f"{W}/ev-dprnt/errors.csv")[1:]]
+    t_sim = [float(l.split(",")[0]) for l in numbers(f"{W}/ev0/errors.csv")[1:]]
+    worst = max(abs(a - b) for a, b in zip(t_log, t_sim))
+    check(f"the DPRNT clock stamps each cycle within 1 s of the simulated triggers (worst {worst:.3f} s over {len(t_log)} cycles)",
+          len(t_log) == len(t_sim) and worst < 1.0)
 
 # Without times, the planned schedule stamps the points (each paired with its nearest planned
 # contact): the shuffled file and the original, both without time_s, agree.
