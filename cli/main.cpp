@@ -199,7 +199,7 @@ int cmdSimulate(const std::vector<std::string>& program_files, const std::string
 int cmdEvaluate(const std::string& points_file, const std::string& manifest_file, const std::string& out_dir,
                 const std::string& format, bool free_radius, const std::string& scene_file,
                 std::optional<double> exaggeration_opt, const std::string& compare_with, double gauge_resolution_um,
-                const std::string& probe_log) {
+                const std::string& probe_log, const std::string& cycle_starts) {
   const auto m = parts::readManifest(manifest_file);
   evaluate::EvaluateRequest req;
   req.input_file = points_file;
@@ -207,6 +207,7 @@ int cmdEvaluate(const std::string& points_file, const std::string& manifest_file
   req.free_radius = free_radius;
   req.compare_with = compare_with;
   req.probe_log = probe_log;
+  req.cycle_starts = cycle_starts;
   req.out_dir = out_dir;
   req.gauge_resolution_um = gauge_resolution_um;
   const auto f = evaluate::evaluateTestPiece(m, req);
@@ -380,6 +381,9 @@ int main(int argc, char** argv) {
   std::string probe_log;
   ev->add_option("--probe-log", probe_log, "stepped workpiece: the on-machine probe log, evaluated with the CMM export (seed 000: CMM - probe)")
       ->check(CLI::ExistingFile);
+  std::string cycle_starts;
+  ev->add_option("--cycle-starts", cycle_starts, "sphere campaign: a CSV cycle,start_s of when each cycle started (s, the inputs' "
+                 "clock), for a log without clocks; replaces the plan's schedule")->check(CLI::ExistingFile);
   ev->add_option("--compare", compare_with, "another run's evaluation.json: thermal test piece, seed 004 Table 7.2 reductions; stepped workpiece, the part before its compensation (before/after)")
       ->check(CLI::ExistingFile);
 
@@ -436,7 +440,7 @@ int main(int argc, char** argv) {
     if (*fit) return cmdFit(fa);
     if (*gum) return cmdGum(gum_model, gum_mcm || gum_trials > 0, gum_trials, seed, gum_digits, gum_json);
     if (*ev)
-      return cmdEvaluate(points, manifest, out, format, free_radius, scene, exaggeration, compare_with, gauge_resolution_um, probe_log);
+      return cmdEvaluate(points, manifest, out, format, free_radius, scene, exaggeration, compare_with, gauge_resolution_um, probe_log, cycle_starts);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "probeloop: error: %s\n", e.what());
     return 1;

@@ -38,6 +38,8 @@ struct ModelArgs {
   // series
   std::vector<std::string> series_parts;  // evaluation.json, inputs.csv, evaluation.json, ...
   std::string out = "series";
+  int train_parts = 0;
+  std::string start_from;
   double gap_h = 24;
 };
 
@@ -189,13 +191,29 @@ int runSeries(const ModelArgs& a) {
   for (std::size_t i = 0; i + 1 < a.series_parts.size(); i += 2)
     parts.push_back({readJsonFile(a.series_parts[i]), a.series_parts[i], model::loadInputs(a.series_parts[i + 1])});
   if (!std::isfinite(a.gap_h) || a.gap_h < 0) throw InputError("", 0, "model series: --gap-h must be a finite number of hours >= 0");
-  const auto s = model::buildSteppedSeries(parts, a.gap_h * 3600.0);
+  const auto s = model::buildSteppedSeries(parts, a.gap_h * 3600.0, a.train_parts);
+  // --start-from: a grown campaign goes on from the model the last loop ended with (its effects,
+  // the new series' data and split).
+  std::string model_yaml = s.model_yaml;
+  if (!a.start_from.empty()) {
+    auto em = parts::loadErrorModel(a.start_from);
+    for (const auto& c : em.channels)
+      if (c.channel != "width_x_um" && c.channel != "width_y_um" && c.channel != "depth_um")
+        throw InputError(a.start_from, 0, "channel " + c.channel + ": the stepped series has width_x_um, width_y_um and depth_um");
+    for (auto& c : em.channels)
+      for (auto& e : c.effects) e.just_added = false;
+    em.inputs_path = "inputs.csv";
+    em.errors_path = "errors.csv";
+    em.training_fraction = s.training_fraction;
+    model_yaml = parts::errorModelYaml(em);
+  }
   fs::create_directories(a.out);
   writeFileAtomic((fs::path(a.out) / "inputs.csv").string(), s.inputs_csv);
   writeFileAtomic((fs::path(a.out) / "errors.csv").string(), s.errors_csv);
-  writeFileAtomic((fs::path(a.out) / "model.yaml").string(), s.model_yaml);
+  writeFileAtomic((fs::path(a.out) / "model.yaml").string(), model_yaml);
   std::fputs(s.summary.c_str(), stdout);
-  std::printf("  wrote inputs.csv, errors.csv and model.yaml (position error only) in %s\n", a.out.c_str());
+  std::printf("  wrote inputs.csv, errors.csv and model.yaml (%s) in %s\n",
+              a.start_from.empty() ? "position error only" : ("the effects of " + a.start_from).c_str(), a.out.c_str());
   return 0;
 }
 
@@ -255,6 +273,10 @@ std::function<int()> addModelCommands(CLI::App& app, CLI::App*& group) {
   series->add_option("--part", a->series_parts, "a part's evaluation.json and its machine's inputs.csv (repeat, in cut order)")
       ->required()->type_size(2)->allow_extra_args(false)->check(CLI::ExistingFile);
   series->add_option("--gap-h", a->gap_h, "hours the machine stands between two parts")->capture_default_str()->check(CLI::NonNegativeNumber);
+  series->add_option("--train-parts", a->train_parts, "the first N parts train, the rest validate (default: the first 60 % of the steps)")
+      ->check(CLI::PositiveNumber);
+  series->add_option("--start-from", a->start_from, "model.yaml whose effects the new model starts from (default: the position error only)")
+      ->check(CLI::ExistingFile);
   series->add_option("--out", a->out, "output folder")->capture_default_str();
   return [a, fit, cmp, dia, add, talc, series]() -> int {
     if (*series) return runSeries(*a);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -207,6 +208,32 @@ std::vector<ProbeRecord> readProbeRecords(const std::string& path, PointsFormat 
                                          "the manifest " + m.file);
   }
   return out;
+}
+
+void applyCycleStarts(parts::PlanManifest& m, const std::string& path) {
+  const CsvTable t = parseCsv(readFile(path), path);
+  const int cc = t.column("cycle"), cs = t.column("start_s");
+  if (cc < 0 || cs < 0)
+    throw InputError(path, t.header_line, "expected the columns cycle,start_s (the start of each cycle on the inputs' clock, s)");
+  if (t.rows.empty()) throw InputError(path, t.header_line, "no cycles listed");
+  if (static_cast<int>(t.rows.size()) > m.cycles)
+    throw InputError(path, t.rows[m.cycles].line, "cycle " + std::to_string(m.cycles + 1) + ": the plan " + m.file + " has " +
+                                                      std::to_string(m.cycles) + " cycles");
+  std::vector<double> starts;
+  for (std::size_t i = 0; i < t.rows.size(); ++i) {
+    const auto& r = t.rows[i];
+    const double c = t.number(r, cc);
+    if (c != static_cast<double>(i + 1))
+      throw InputError(path, r.line, "cycle: " + r.fields[cc] + "; expected " + std::to_string(i + 1) +
+                                         " (every cycle from 1, in order, once)");
+    const double s = t.number(r, cs);
+    if (!starts.empty() && !(s > starts.back()))
+      throw InputError(path, r.line, "start_s: " + r.fields[cs] + " is not after cycle " + std::to_string(i) + "'s " +
+                                         formatNumber(starts.back()) + " s");
+    starts.push_back(s);
+  }
+  m.cycle_start_s.assign(m.cycles, std::numeric_limits<double>::quiet_NaN());
+  std::copy(starts.begin(), starts.end(), m.cycle_start_s.begin());
 }
 
 }  // namespace probeloop::evaluate

@@ -39,4 +39,13 @@ struct ProbeRecord {
 std::vector<ProbeRecord> readProbeRecords(const std::string& path, PointsFormat format,
                                           const parts::PlanManifest& manifest);
 
+// A user's file of cycle start times (`evaluate --cycle-starts`): CSV `cycle,start_s` (the
+// separators and decimal marks of core/csv.hpp), the cycles 1, 2, … N in order, each once, the
+// starts strictly increasing, N at most the plan's cycles. They replace the plan's schedule
+// (manifest.cycle_start_s) for those cycles; cycles after N get NaN, so that a point of theirs
+// without its own time is refused by the evaluation rather than stamped from the plan. A point
+// that carries its own time (a points CSV's time_s, a Fanuc log's clock) keeps it.
+// InputError with file:line:field otherwise.
+void applyCycleStarts(parts::PlanManifest& manifest, const std::string& path);
+
 }  // namespace probeloop::evaluate

@@ -85,6 +85,9 @@ CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& m,
       for (const auto* r : pit->second) {
         pts.push_back(r->tip_mm);
         const auto& planned = m.points[(s.position - 1) * m.pointsPerSphere() + (r->point - 1)];
+        if (!r->time_s && std::isnan(m.cycle_start_s[cyc - 1]))
+          throw InputError(r->file, r->line, "cycle " + std::to_string(cyc) +
+                                                 ": no start time (the --cycle-starts file ends before it) and no time of its own");
         const double t = r->time_s ? *r->time_s : m.cycle_start_s[cyc - 1] + planned.time_in_cycle_s;
         t_sum += t;
         tp += t;

@@ -34,7 +34,9 @@ void appendf(std::string& out, const char* fmt, ...) {
 
 std::string join(const std::string& dir, const std::string& file) { return (std::filesystem::path(dir) / file).string(); }
 
-EvaluationFiles sphere(const parts::PlanManifest& m, const EvaluateRequest& r) {
+EvaluationFiles sphere(const parts::PlanManifest& planned, const EvaluateRequest& r) {
+  parts::PlanManifest m = planned;
+  if (!r.cycle_starts.empty()) applyCycleStarts(m, r.cycle_starts);
   const auto records = readProbeRecords(r.input_file, parsePointsFormat(r.format), m);
   EvaluateOptions opt;
   opt.known_radius = !r.free_radius;
@@ -110,6 +112,8 @@ EvaluationFiles evaluateTestPiece(const parts::PlanManifest& m, const EvaluateRe
       throw InputError("", 0, "--compare applies to the thermal test piece (seed 004 Table 7.2), not to a sphere-artifact campaign");
     return sphere(m, r);
   }
+  if (!r.cycle_starts.empty())
+    throw InputError(r.cycle_starts, 0, "--cycle-starts applies to a sphere-artifact campaign's cycles, not to a " + m.kind);
   if (!r.probe_log.empty() && m.kind != "stepped_workpiece")
     throw InputError("", 0, "--probe-log applies to the stepped workpiece (its CMM export and probe log together)");
   if (m.kind == "thermal_test_piece") return thermalTestPiece(m, r);

@@ -25,6 +25,7 @@ struct EvaluateRequest {
   std::string out_dir = ".";     // only for the file names printed in stdout_text
   double gauge_resolution_um = 1.0;  // thermal test piece, dial-gauge route (not stated in the thesis)
   std::string probe_log;         // stepped workpiece: the on-machine probe log beside the CMM export (input_file)
+  std::string cycle_starts;      // sphere artifact: a user's cycle start times (ingest.hpp applyCycleStarts)
 };
 
 struct EvaluationFiles {

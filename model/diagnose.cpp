@@ -95,6 +95,9 @@ std::string physics(const Effect& e, const std::string& what) {
       if (in.rfind("feed", 0) == 0)
         return "the cutting force grows with the feed (F = k_c Q / v_c) and deflects the tool and the structure; "
                "finish at a lower feed or compensate the deflection";
+      if (in.rfind("transition_feed", 0) == 0)
+        return "the moves that join the walls wind the drives up (lost motion held when the axis stops), the control error "
+               "of seed 000 Sec. 3.6.2; join them slower, or compensate it per transition feed";
       return "the error moves with " + in + " without delay";
     case EffectKind::Lag:
       if (isSpeedInput(in) && (in.rfind("c_", 0) == 0 || in.find("rotary") != std::string::npos))

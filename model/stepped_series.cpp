@@ -21,7 +21,7 @@ struct StepRow {
 
 struct StepCondition {
   double start_s = 0;  // on the combined clock
-  double travel = 0, depth = 0, feed = 0, feed_per_rev = 0;
+  double travel = 0, depth = 0, feed = 0, feed_per_rev = 0, transition_feed = 0;
 };
 
 bool isEventOrSwitch(const std::string& c) { return c == "tool_changes" || c == "mwf_on"; }
@@ -29,8 +29,12 @@ bool isEventOrSwitch(const std::string& c) { return c == "tool_changes" || c == 
 
 }  // namespace
 
-SteppedSeries buildSteppedSeries(const std::vector<SteppedSeriesPart>& parts, double gap_s) {
+SteppedSeries buildSteppedSeries(const std::vector<SteppedSeriesPart>& parts, double gap_s, int training_parts) {
   if (parts.empty()) throw InputError("", 0, "model series: no parts given");
+  if (training_parts < 0 || training_parts > static_cast<int>(parts.size()))
+    throw InputError("", 0, "model series: --train-parts " + std::to_string(training_parts) + ": between 1 and the " +
+                                std::to_string(parts.size()) + " parts given (0: the first 60 % of the steps)");
+  int training_rows = 0;
   const auto& names = parts.front().inputs.names;
   const double step = parts.front().inputs.step_s;
   std::vector<double> t_all;
@@ -72,6 +76,13 @@ SteppedSeries buildSteppedSeries(const std::vector<SteppedSeriesPart>& parts, do
       t_all.push_back(in.t_s[k] + offset);
       for (std::size_t c = 0; c < names.size(); ++c) cols[c].push_back(in.columns[c][k]);
     }
+    // The moves that join the walls (evaluation.json's transition): their feed winds the drives
+    // up (the thesis's control error, Sec. 3.6.2); a continuous path has none.
+    if (!part.evaluation.contains("transition"))
+      throw InputError(file, 0, "transition: missing (an evaluation.json written before the control separation: run evaluate again)");
+    const std::string transition = part.evaluation.at("transition").is_string() ? part.evaluation.at("transition").get<std::string>() : "";
+    const double transition_feed =
+        transition == "continuous" ? 0.0 : evaluationNumber(part.evaluation, "transition_feed_mm_per_min", "", file);
     const auto& seps = part.evaluation.at("separation");
     const auto& cmm = part.evaluation.contains("cmm") ? part.evaluation.at("cmm").value("steps", json::array()) : json::array();
     if (cmm.size() != seps.size()) throw InputError(file, 0, "cmm.steps: " + std::to_string(cmm.size()) + " steps, separation " + std::to_string(seps.size()));
@@ -116,8 +127,10 @@ SteppedSeries buildSteppedSeries(const std::vector<SteppedSeriesPart>& parts, do
       const double S = evaluationNumber(s, "spindle_rpm", where, file);
       if (!(S > 0)) throw InputError(file, 0, where + "spindle_rpm: must be positive (the feed per revolution divides by it)");
       c.feed_per_rev = 1000.0 * c.feed / S;
+      c.transition_feed = transition_feed;
       conds.push_back(c);
     }
+    if (static_cast<int>(p) < training_parts) training_rows = static_cast<int>(rows.size());
     comment << "# part " << p + 1 << ": " << file << " (" << part.evaluation.value("experiment", "?") << "), inputs " << in.file
             << " shifted by " << formatNumber(offset, 1) << " s\n";
   }
@@ -130,14 +143,15 @@ SteppedSeries buildSteppedSeries(const std::vector<SteppedSeriesPart>& parts, do
   std::ostringstream in;
   in << "time_s";
   for (const auto& n : names) in << "," << n;
-  in << ",travel_mm,depth_mm,cut_feed_mm_per_min,chip_load_um_per_rev\n";
+  in << ",travel_mm,depth_mm,cut_feed_mm_per_min,chip_load_um_per_rev,transition_feed_mm_per_min\n";
   std::size_t c = 0;
   for (std::size_t k = 0; k < t_all.size(); ++k) {
     while (c + 1 < conds.size() && conds[c + 1].start_s <= t_all[k]) ++c;
     in << formatNumber(t_all[k], 3);
     for (const auto& col : cols) in << "," << formatNumber(col[k], 4);
     const auto& s = conds[c];
-    in << "," << formatNumber(s.travel, 3) << "," << formatNumber(s.depth, 3) << "," << formatNumber(s.feed, 1) << "," << formatNumber(s.feed_per_rev, 4) << "\n";
+    in << "," << formatNumber(s.travel, 3) << "," << formatNumber(s.depth, 3) << "," << formatNumber(s.feed, 1) << "," << formatNumber(s.feed_per_rev, 4) << ","
+       << formatNumber(s.transition_feed, 1) << "\n";
   }
   out.inputs_csv = in.str();
   std::ostringstream er;
@@ -149,12 +163,15 @@ SteppedSeries buildSteppedSeries(const std::vector<SteppedSeriesPart>& parts, do
        << formatNumber(r.U_x, 4) << "," << formatNumber(r.U_y, 4) << "," << formatNumber(r.U_z, 4) << "\n";
   }
   out.errors_csv = er.str();
+  // The first N parts train (trainingEnd rounds fraction x rows back to training_rows).
+  const std::string fraction = training_parts > 0 ? formatNumber(static_cast<double>(training_rows) / rows.size(), 6) : "0.6";
+  out.training_fraction = std::stod(fraction);
   out.model_yaml =
       "# The starting model of the stepped workpiece's loop: the position error only (seed 000 §9.1 item 10).\n"
       "# `probeloop model diagnose` names what is missing; `probeloop model add` adds it.\n"
       "kind: error_model\n"
       "data: {inputs: inputs.csv, errors: errors.csv}\n"
-      "training_fraction: 0.6\n"
+      "training_fraction: " + fraction + "\n"
       "channels:\n"
       "  width_x_um: [{effect: static, input: travel_mm}]\n"
       "  width_y_um: [{effect: static, input: travel_mm}]\n"

@@ -19,10 +19,15 @@
 //   depth_mm               the floor's nominal depth below the top;
 //   cut_feed_mm_per_min    the step's XY feed (the thesis's process variable);
 //   chip_load_um_per_rev   the feed per spindle revolution, 1000 F / S (the chip load);
+//   transition_feed_mm_per_min  the feed of the moves that join the walls (evaluation.json's
+//                          transition_feed; 0 for a continuous path, which has none): what winds
+//                          the drives up before a wall, the thesis's control error (Sec. 3.6.2);
 // model.yaml: the starting model "position error only": static(travel_mm) for the widths,
-// static(depth_mm) for the depth, trained on the first 60 % of the rows.
+// static(depth_mm) for the depth, trained on the first 60 % of the rows, or on the first
+// `training_parts` parts' rows when that is > 0.
 //
-// Contract: InputError naming the file: not a stepped evaluation, a step without cut_mid_s
+// Contract: InputError naming the file: not a stepped evaluation, no transition (an evaluation
+// older than the control separation), training_parts beyond the parts given, a step without cut_mid_s
 // (an evaluation older than this series), inputs whose columns or step differ from the first
 // part's, a cut time outside its part's inputs; parts in the order given.
 #pragma once
@@ -43,9 +48,10 @@ struct SteppedSeriesPart {
 struct SteppedSeries {
   std::string inputs_csv, errors_csv, model_yaml;
   int rows = 0;
+  double training_fraction = 0.6;  // what model.yaml says
   std::string summary;
 };
 
-SteppedSeries buildSteppedSeries(const std::vector<SteppedSeriesPart>& parts, double gap_s = 24 * 3600.0);
+SteppedSeries buildSteppedSeries(const std::vector<SteppedSeriesPart>& parts, double gap_s = 24 * 3600.0, int training_parts = 0);
 
 }  // namespace probeloop::model

@@ -9,6 +9,7 @@
 
 #include "core/csv.hpp"
 #include "core/error.hpp"
+#include "model/fit.hpp"
 
 namespace probeloop::model {
 namespace {
@@ -32,8 +33,10 @@ InputSeries log(const std::string& file, double T0) {
 }
 
 // Two steps: cut 20-50 s (mid 35) and 50-90 s (mid 70); sizes 30 and 45, tool d 10.
-json evaluation(const char* id, double feed2) {
-  json j{{"kind", "stepped_workpiece"}, {"experiment", id}};
+// Walls joined by 100 mm/min moves unless said otherwise.
+json evaluation(const char* id, double feed2, const char* transition = "non_cutting", double transition_feed = 100) {
+  json j{{"kind", "stepped_workpiece"}, {"experiment", id}, {"transition", transition}};
+  if (std::string(transition) != "continuous") j["transition_feed_mm_per_min"] = transition_feed;
   const double start[2] = {20, 50}, end[2] = {50, 90}, T[2] = {0.25, 0.8333333333333334}, F[2] = {100, feed2};
   for (int i = 0; i < 2; ++i) {
     j["separation"].push_back({{"step", i + 1}, {"feed_mm_per_min", F[i]}, {"spindle_rpm", 1000}, {"temp_state_min", T[i]},
@@ -48,7 +51,7 @@ json evaluation(const char* id, double feed2) {
 
 TEST(SteppedSeries, TwoPartsOnOneClockWithTheGapBetween) {
   const auto s = buildSteppedSeries({{evaluation("W8", 200), "w8.json", log("w8.csv", 20)},
-                                     {evaluation("W6", 400), "w6.json", log("w6.csv", 22)}},
+                                     {evaluation("W2", 400, "fast", 1200), "w2.json", log("w2.csv", 22)}},
                                     60.0);
   EXPECT_EQ(s.rows, 4);
   const auto in = parseCsv(s.inputs_csv, "inputs.csv");
@@ -70,6 +73,11 @@ TEST(SteppedSeries, TwoPartsOnOneClockWithTheGapBetween) {
   EXPECT_DOUBLE_EQ(in.number(in.rows[18], L), 55);  // 180 s: part 2 has not started cutting
   EXPECT_DOUBLE_EQ(in.number(in.rows[19], L), 40);  // 190 s
   EXPECT_DOUBLE_EQ(in.number(in.rows[22], f), 400);  // 220 s: part 2 step 2, 1000 x 400 / 1000
+  // The walls' joining feed: part 1's from its first step, part 2's from its first step on.
+  const int tf = in.column("transition_feed_mm_per_min");
+  EXPECT_DOUBLE_EQ(in.number(in.rows[0], tf), 100);
+  EXPECT_DOUBLE_EQ(in.number(in.rows[18], tf), 100);
+  EXPECT_DOUBLE_EQ(in.number(in.rows[19], tf), 1200);
   const auto er = parseCsv(s.errors_csv, "errors.csv");
   ASSERT_EQ(er.rows.size(), 4u);
   const int et = er.column("time_s"), wx = er.column("width_x_um"), U = er.column("U_width_y_um");
@@ -78,6 +86,24 @@ TEST(SteppedSeries, TwoPartsOnOneClockWithTheGapBetween) {
   EXPECT_DOUBLE_EQ(er.number(er.rows[3], wx), 4);
   EXPECT_DOUBLE_EQ(er.number(er.rows[1], U), 2.2);
   EXPECT_NE(s.model_yaml.find("width_x_um: [{effect: static, input: travel_mm}]"), std::string::npos);
+  EXPECT_NE(s.model_yaml.find("training_fraction: 0.6\n"), std::string::npos);
+}
+
+// --train-parts: the first N parts' rows train, whatever 60 % would be (2 + 2 + 2 rows, N = 2:
+// 4 / 6, which trainingEnd rounds back to 4); a continuous path has no transitions (0).
+TEST(SteppedSeries, TheFirstPartsTrainWhenAsked) {
+  const auto s = buildSteppedSeries({{evaluation("W8", 200), "w8.json", log("w8.csv", 20)},
+                                     {evaluation("W6", 400), "w6.json", log("w6.csv", 22)},
+                                     {evaluation("W5", 400, "continuous"), "w5.json", log("w5.csv", 24)}},
+                                    60.0, 2);
+  EXPECT_NE(s.model_yaml.find("training_fraction: 0.666667\n"), std::string::npos) << s.model_yaml;
+  EXPECT_EQ(trainingEnd(s.rows, 0.666667), 4);
+  const auto in = parseCsv(s.inputs_csv, "inputs.csv");
+  EXPECT_DOUBLE_EQ(in.number(in.rows.back(), in.column("transition_feed_mm_per_min")), 0);
+  EXPECT_THROW(buildSteppedSeries({{evaluation("W8", 200), "w8.json", log("w8.csv", 20)}}, 60.0, 2), InputError);
+  auto old = evaluation("W8", 200);
+  old.erase("transition");
+  EXPECT_THROW(buildSteppedSeries({{old, "w8.json", log("w8.csv", 20)}}), InputError);
 }
 
 // A compensated part was cut off nominal on purpose: its rows are the CMM's error plus the

@@ -46,10 +46,8 @@ rm -rf "$OUT/plan" "$OUT/run" "$OUT/eval"
 "$PL" plan "$art" --machine "$MACHINE" --out "$OUT/plan" > /dev/null
 "$PL" simulate "$OUT/plan/sphere_cycle.nc" --machine "$MACHINE" --part "$art" --truth "$TRUTH" \
   --out "$OUT/run" --seed "$SEED" > /dev/null
-# Evaluate the canonical points (the same reported coordinates as dprnt.txt, plus each
-# trigger's time), not the DPRNT log: a log carries no times, so its errors.csv would be
-# stamped with the plan's schedule, which follows the simulated clock to about 0.07 s per
-# cycle (docs/sphere-cycle.md: probing moves meet the sphere where the errors put it), some
-# 30 s over 48 h. A lag or a transient needs the errors on the inputs' clock.
+# Evaluate the canonical points (the same reported coordinates as dprnt.txt, each trigger's time
+# to the millisecond). The DPRNT log carries the controller's clock to the second; model_cli.py
+# evaluates it too and checks that its stamps and the lag fitted from them agree with these.
 "$PL" evaluate "$OUT/run/points.csv" --format csv --manifest "$OUT/plan/plan.json" --out "$OUT/eval" > /dev/null
 echo "$NAME (seed $SEED): $OUT/run/inputs.csv, $OUT/eval/errors.csv, $OUT/run/truth.json"

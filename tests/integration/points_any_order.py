@@ -5,7 +5,7 @@ position, foreign labels, no point numbers, a UTF-8 byte-order mark, CRLF, ';' s
 decimal commas), evaluates to the same errors.csv as the original, to the printed digit.
 Also: the Fanuc DPRNT log's clock (#3011/#3012) stamps each cycle within 1 s of the simulated
 triggers; the plan's schedule (cycle starts + times in the cycle) within 1 s of the simulated clock
-over the campaign; one point fewer per position still evaluates (n >= 4 with a known radius); a point moved
+over the campaign; a user's file of cycle start times (--cycle-starts) stamps points without times; one point fewer per position still evaluates (n >= 4 with a known radius); a point moved
 off its sphere, a comma-separated file with decimal commas and a C angle not planned are refused
 naming file and line, and nothing is written.
 
@@ -118,6 +118,51 @@ c0, _, e0 = evaluate(f"{W}/nt0.csv", f"{W}/ev-nt0")
 c1, _, e1 = evaluate(f"{W}/nt1.csv", f"{W}/ev-nt1")
 check("without time_s, shuffled and relabelled, the same errors.csv as the original without time_s",
       c0 == 0 and c1 == 0 and numbers(f"{W}/ev-nt0/errors.csv") == numbers(f"{W}/ev-nt1/errors.csv"), e0 + e1)
+
+# A user's file of cycle start times (--cycle-starts) stamps a log without clocks: the starts read
+# off the simulated triggers (each cycle's earliest trigger minus its planned time in the cycle)
+# give each cycle's time within 1 s of the timed points'; the same starts 500 s later move every
+# time by 500 s and change no error; a file that skips a cycle, or ends before the log does, is
+# refused naming the line or the cycle, and nothing is written.
+sim_start = {}
+for r in rows:
+    c = int(r["cycle"])
+    s0 = float(r["time_s"]) - planned[(r["feature"], int(r["point"]))]
+    sim_start[c] = min(sim_start.get(c, s0), s0)
+
+
+def starts_file(name, shift=0.0, cycles=None, sep=","):
+    path = f"{W}/{name}.csv"
+    with open(path, "w") as f:
+        f.write(f"cycle{sep}start_s\n" + "".join(f"{c}{sep}{sim_start[c] + shift:.3f}\n".replace(".", "," if sep == ";" else ".")
+                                              for c in (cycles or sorted(sim_start))))
+    return path
+
+
+def evaluate_starts(starts, out):
+    return run("evaluate", f"{W}/nt0.csv", "--format", "csv", "--manifest", f"{W}/plan/plan.json", "--cycle-starts", starts, "--out", out)
+
+
+c0, _, e0 = evaluate_starts(starts_file("starts", sep=";"), f"{W}/ev-st0")
+c1, _, e1 = evaluate_starts(starts_file("starts-late", 500.0), f"{W}/ev-st1")
+check("--cycle-starts (';' and decimal commas) evaluates", c0 == 0 and c1 == 0, e0 + e1)
+if c0 == 0 and c1 == 0:
+    a, b, ref = (numbers(f"{W}/{d}/errors.csv")[1:] for d in ("ev-st0", "ev-st1", "ev0"))
+    worst = max(abs(float(x.split(",")[0]) - float(y.split(",")[0])) for x, y in zip(a, ref))
+    check(f"the user's cycle starts stamp each cycle within 1 s of the simulated triggers (worst {worst:.3f} s)",
+          len(a) == len(ref) and worst < 1.0)
+    shifted = all(abs(float(y.split(",")[0]) - float(x.split(",")[0]) - 500.0) < 1e-3 and x.split(",")[1:] == y.split(",")[1:]
+                  for x, y in zip(a, b))
+    check("starts 500 s later: every time 500 s later, every error the same", len(a) == len(b) and shifted)
+n_cycles = len(sim_start)
+for name, path, want in (("a skipped cycle", starts_file("starts-skip", cycles=[1, 3]), "starts-skip.csv:3: cycle: 3; expected 2"),
+                         ("a file that ends early", starts_file("starts-short", cycles=list(range(1, n_cycles))),
+                          f"cycle {n_cycles}: no start time"),
+                         ("starts not increasing", f"{W}/starts-back.csv", "starts-back.csv:3: start_s: 5 is not after")):
+    if name == "starts not increasing":
+        open(path, "w").write("cycle,start_s\n1,10\n2,5\n")
+    code, _, err = evaluate_starts(path, f"{W}/bad-starts")
+    check(f"--cycle-starts with {name}: refused with '{want}', nothing written", code != 0 and want in err and not os.path.exists(f"{W}/bad-starts"), err)
 
 # One point fewer per position: still a sphere with its known radius.
 fewer = []
