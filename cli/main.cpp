@@ -21,6 +21,8 @@
 #include "evaluate/point_cloud.hpp"
 #include "evaluate/sphere_campaign.hpp"
 #include "evaluate/test_piece.hpp"
+#include "interop/qif.hpp"
+#include "interop/summary.hpp"
 #include "model/stepped_prediction.hpp"
 #include "parts/gum_model.hpp"
 #include "parts/machine.hpp"
@@ -146,7 +148,12 @@ int cmdSimulate(const std::vector<std::string>& program_files, const std::string
   sim::SimulationPart part;
   part.test_piece = &piece;
   if (!cmm_file.empty()) {
-    part.cmm_points = sim::readCmmPoints(cmm_file);
+    if (interop::looksLikeQif(readFile(cmm_file))) {  // a QIF plan: the CMM answers in QIF too
+      part.cmm_qif_plan = interop::readQifPlan(cmm_file);
+      part.cmm_points = sim::cmmPointsOfQifPlan(*part.cmm_qif_plan);
+    } else {
+      part.cmm_points = sim::readCmmPoints(cmm_file);
+    }
     part.cmm_points_file = cmm_file;
   }
   part.trace = trace;
@@ -188,6 +195,10 @@ int cmdSimulate(const std::vector<std::string>& program_files, const std::string
   if (!s.cmm_csv.empty()) {
     writeFileAtomic(join(out_dir, "cmm_export.csv"), s.cmm_csv);
     extra += ", cmm_export.csv";
+  }
+  if (!s.cmm_qif.empty()) {
+    writeFileAtomic(join(out_dir, "cmm_results.qif"), s.cmm_qif);
+    extra += ", cmm_results.qif";
   }
   const std::string what = program_files.size() == 1 ? program_files.front() : std::to_string(program_files.size()) + " programs";
   std::printf("Simulated %s on %s (seed %llu): %ld blocks, %ld probe events, %.1f h of machine time\n", what.c_str(),
@@ -239,6 +250,19 @@ int cmdEvaluate(const std::string& points_file, const std::string& manifest_file
     std::printf("Wrote %s (%s x%s)\n", scene_file.c_str(), f.sphere ? "error vectors" : "deviation vectors",
                 formatNumber(exaggeration).c_str());
   }
+  return 0;
+}
+
+// Results when the file has any; a plan (its nominal features and planned points) otherwise.
+int cmdRead(const std::string& file, bool json) {
+  auto d = interop::readQifResults(file);
+  if (d.runs == 0 && d.features.empty()) {
+    try {
+      d = interop::readQifPlan(file);
+    } catch (const InputError&) {  // no feature nominals either: the empty results say so
+    }
+  }
+  std::fputs((json ? interop::cmmDocumentJson(d) : interop::cmmDocumentText(d)).c_str(), stdout);
   return 0;
 }
 
@@ -335,6 +359,12 @@ int main(int argc, char** argv) {
   plan->add_option("--compensate", compensate, "stepped workpiece: compensation.json (from evaluate): the predicted wall and "
                    "floor errors taken out of the finishing path (seed 000 Ch. 6)")->check(CLI::ExistingFile);
 
+  std::string read_file;
+  bool read_json = false;
+  auto* rd = app.add_subcommand("read", "What probeloop reads in a CMM exchange file (QIF 3.0 Results or Plan): features, points, units");
+  rd->add_option("file", read_file, "QIF 3.0 file")->required()->check(CLI::ExistingFile);
+  rd->add_flag("--json", read_json, "print JSON (every feature with its geometry and points, in mm)");
+
   auto* res = app.add_subcommand("resolution", "Resolution of the location errors (seed 004 Table 5.4)");
   res->add_option("artifact", artifact, "sphere artifact description (YAML)")->required()->check(CLI::ExistingFile);
   res->add_option("--machine", machine, "machine description (YAML)")->required()->check(CLI::ExistingFile);
@@ -359,7 +389,7 @@ int main(int argc, char** argv) {
   simc->add_option("--out", out, "output folder")->capture_default_str();
   simc->add_option("--seed", seed, "random seed")->capture_default_str();
   simc->add_option("--cmm-points", cmm_points, "machined part: CMM points to measure after the programs "
-                   "(feature,point,x_mm,y_mm,z_mm,nx,ny,nz)")->check(CLI::ExistingFile);
+                   "(feature,point,x_mm,y_mm,z_mm,nx,ny,nz, or a QIF 3.0 plan: then cmm_results.qif too)")->check(CLI::ExistingFile);
   simc->add_flag("--trace", sim_trace, "also write trace.csv: every motion, dwell and tool change with its time and line");
   std::string schedule;
   simc->add_option("--schedule", schedule, "plan manifest (plan.json): start each program at its planned time, the machine "
@@ -367,11 +397,11 @@ int main(int argc, char** argv) {
 
   std::string compare_with;
   auto* ev = app.add_subcommand("evaluate", "Errors of a test piece from probe logs, points CSV, a CMM export or dial-gauge readings");
-  ev->add_option("points", points, "LinuxCNC log, Fanuc DPRNT output, points CSV, CMM export or gauge CSV")->required()->check(CLI::ExistingFile);
+  ev->add_option("points", points, "LinuxCNC log, Fanuc DPRNT output, points CSV, CMM export (CSV or QIF 3.0 Results) or gauge CSV")->required()->check(CLI::ExistingFile);
   ev->add_option("--manifest", manifest, "plan manifest (plan.json)")->required()->check(CLI::ExistingFile);
   ev->add_option("--out", out, "output folder")->capture_default_str();
-  ev->add_option("--format", format, "auto, linuxcnc, fanuc, csv, cmm or gauge")
-      ->check(CLI::IsMember({"auto", "linuxcnc", "fanuc", "csv", "cmm", "gauge"}))->capture_default_str();
+  ev->add_option("--format", format, "auto, linuxcnc, fanuc, csv, cmm, qif or gauge")
+      ->check(CLI::IsMember({"auto", "linuxcnc", "fanuc", "csv", "cmm", "qif", "gauge"}))->capture_default_str();
   ev->add_flag("--free-radius", free_radius, "sphere centres from the free-radius fit (default: known radius)");
   ev->add_option("--scene", scene, "also write a glTF scene (the sphere campaign, or the test piece with its deviations)");
   ev->add_option("--exaggeration", exaggeration, "scale of the error vectors in the scene (default: 10000 sphere campaign, 1000 test piece)");
@@ -435,6 +465,7 @@ int main(int argc, char** argv) {
     if (*separate_cmd) return run_separate();
     if (*plan) return cmdPlan(artifact, machine, out, dialect, experiment, compensate, predict_from);
     if (*res) return cmdResolution(artifact, machine, step_um);
+    if (*rd) return cmdRead(read_file, read_json);
     if (*syn) return cmdSynth(manifest, truth, out, seed);
     if (*simc) return cmdSimulate(sim_programs, machine, part, truth, out, seed, cmm_points, sim_trace, schedule);
     if (*fit) return cmdFit(fa);

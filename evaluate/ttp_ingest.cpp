@@ -10,6 +10,7 @@
 
 #include "core/csv.hpp"
 #include "core/error.hpp"
+#include "interop/qif.hpp"
 #include "core/units.hpp"
 #include "gcode/probe_log.hpp"
 #include "parts/machine.hpp"
@@ -119,6 +120,7 @@ Vector3d partToMachine(const parts::PlanManifest& m, const Vector3d& p, double c
 }
 
 std::string detectTtpFormat(const std::string& path, const std::string& text) {
+  if (interop::looksLikeQif(text)) return "qif";
   const std::string first = firstDataLine(text);
   const bool csv = first.find(',') != std::string::npos || first.find(';') != std::string::npos || csvExtension(path);
   if (!csv) return "log";  // a PT log: LinuxCNC LOG and Fanuc DPRNT lines parse alike
@@ -186,46 +188,48 @@ std::vector<std::string> assignByNominalGeometry(const std::vector<Vector3d>& pt
   return out;
 }
 
-TtpPoints readTtpCmmExport(const std::string& path, const std::string& text, const parts::PlanManifest& m) {
-  const CsvTable t = parseCsv(text, path);
-  auto col = [&](const char* a, const char* b) {
-    const int c = t.column(a);
-    return c >= 0 ? c : t.column(b);
-  };
-  const int cx = col("x_mm", "x"), cy = col("y_mm", "y"), cz = col("z_mm", "z");
-  if (cx < 0 || cy < 0 || cz < 0)
-    throw InputError(path, t.header_line,
-                     "a CMM export needs the columns x_mm,y_mm,z_mm (or x,y,z) and optionally feature, point, nx,ny,nz");
-  const int cf = t.column("feature"), cp = t.column("point");
+namespace {
+
+// One point of a CMM export, whatever the file: its label (feature), its number within the
+// feature (0: none), its line.
+struct CmmRawPoint {
+  std::string label;
+  int point = 0;
+  int line = 0;
+  Vector3d p;
+};
+
+// Labels that are all manifest ids are used; none of ours -> the nominal geometry; a mix is
+// refused. Point numbers: the file's with labels, else the order of appearance per feature.
+TtpPoints cmmPointsFromRows(const std::string& path, const std::string& format, const std::vector<CmmRawPoint>& rows,
+                            bool labelled, const parts::PlanManifest& m) {
   TtpPoints out;
   out.file = path;
-  out.format = "cmm";
+  out.format = format;
   out.route = TtpRoute::Cmm;
+  if (rows.empty()) throw InputError(path, 0, "no points");
   std::vector<Vector3d> pts;
   std::vector<int> lines;
-  std::vector<std::string> labels;
-  for (const auto& row : t.rows) {
-    pts.emplace_back(t.number(row, cx), t.number(row, cy), t.number(row, cz));
-    lines.push_back(row.line);
-    labels.push_back(cf >= 0 ? row.fields[static_cast<std::size_t>(cf)] : "");
+  for (const auto& r : rows) {
+    pts.push_back(r.p);
+    lines.push_back(r.line);
   }
-  if (pts.empty()) throw InputError(path, 0, "no points");
-  // Labels: all ours -> used; none ours -> nominal geometry; a mix -> refused.
-  std::size_t ours = 0, first_foreign = pts.size();
-  for (std::size_t i = 0; i < labels.size(); ++i) {
-    if (m.feature(labels[i]))
+  std::size_t ours = 0, first_foreign = rows.size();
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (m.feature(rows[i].label))
       ++ours;
-    else if (first_foreign == pts.size())
+    else if (first_foreign == rows.size())
       first_foreign = i;
   }
   std::vector<std::string> feature;
-  if (cf >= 0 && ours == labels.size()) {
-    feature = labels;
+  if (labelled && ours == rows.size()) {
+    for (const auto& r : rows) feature.push_back(r.label);
     out.assigned_by = "labels";
-  } else if (cf >= 0 && ours > 0) {
+  } else if (labelled && ours > 0) {
     throw InputError(path, lines[first_foreign],
-                     "feature '" + labels[first_foreign] + "' is not a feature of the manifest " + m.file + " (" + idList(m) +
-                         "), but other lines use the manifest's ids: label every point with the manifest's ids, or none "
+                     "feature '" + rows[first_foreign].label + "' is not a feature of the manifest " + m.file + " (" + idList(m) +
+                         "), but other " + (format == "qif" ? "features" : "lines") +
+                         " use the manifest's ids: label every point with the manifest's ids, or none "
                          "(points are then assigned by the nominal geometry)");
   } else {
     feature = assignByNominalGeometry(pts, lines, m, path);
@@ -239,13 +243,7 @@ TtpPoints readTtpCmmExport(const std::string& path, const std::string& text, con
     p.line = lines[i];
     p.p_mm = pts[i];
     const int nth = ++count[p.feature];
-    if (cp >= 0 && out.assigned_by == "labels") {
-      const double k = t.number(t.rows[i], cp);
-      if (k != std::round(k) || k < 1) throw InputError(path, p.line, "point must be a positive integer");
-      p.point = static_cast<int>(k);
-    } else {
-      p.point = nth;
-    }
+    p.point = rows[i].point > 0 && out.assigned_by == "labels" ? rows[i].point : nth;
     const auto key = std::make_pair(p.feature, p.point);
     if (seen.count(key))
       throw InputError(path, p.line, "feature " + p.feature + " point " + std::to_string(p.point) + " appears twice (lines " +
@@ -254,6 +252,54 @@ TtpPoints readTtpCmmExport(const std::string& path, const std::string& text, con
     out.points.push_back(p);
   }
   return out;
+}
+
+// A QIF 3.0 Results document: every measured feature's points, labelled by its name, numbered
+// in their order (the line: the feature measurement's).
+TtpPoints readQifCmmResults(const std::string& path, const std::string& text, const parts::PlanManifest& m) {
+  const auto d = interop::parseQifResults(text, path);
+  if (d.runs > 1)
+    throw InputError(path, 0, std::to_string(d.runs) + " MeasurementResults (runs) in one file: evaluate reads one part's "
+                                                      "measurement; write each run to its own file");
+  std::vector<CmmRawPoint> rows;
+  for (const auto& f : d.features) {
+    int k = 0;
+    for (const auto& p : f.points) rows.push_back({f.name, ++k, f.line, p.p_mm});
+  }
+  if (rows.empty())
+    throw InputError(path, 0, "no measured points (MeasuredPointSets) in " + std::to_string(d.features.size()) +
+                                  " measured features: the evaluation fits its own planes and needs the points");
+  return cmmPointsFromRows(path, "qif", rows, true, m);
+}
+
+}  // namespace
+
+TtpPoints readTtpCmmExport(const std::string& path, const std::string& text, const parts::PlanManifest& m) {
+  if (interop::looksLikeQif(text)) return readQifCmmResults(path, text, m);
+  const CsvTable t = parseCsv(text, path);
+  auto col = [&](const char* a, const char* b) {
+    const int c = t.column(a);
+    return c >= 0 ? c : t.column(b);
+  };
+  const int cx = col("x_mm", "x"), cy = col("y_mm", "y"), cz = col("z_mm", "z");
+  if (cx < 0 || cy < 0 || cz < 0)
+    throw InputError(path, t.header_line,
+                     "a CMM export needs the columns x_mm,y_mm,z_mm (or x,y,z) and optionally feature, point, nx,ny,nz");
+  const int cf = t.column("feature"), cp = t.column("point");
+  std::vector<CmmRawPoint> rows;
+  for (const auto& row : t.rows) {
+    CmmRawPoint r;
+    r.p = Vector3d(t.number(row, cx), t.number(row, cy), t.number(row, cz));
+    r.line = row.line;
+    r.label = cf >= 0 ? row.fields[static_cast<std::size_t>(cf)] : "";
+    if (cp >= 0 && cf >= 0) {
+      const double k = t.number(row, cp);
+      if (k != std::round(k) || k < 1) throw InputError(path, r.line, "point must be a positive integer");
+      r.point = static_cast<int>(k);
+    }
+    rows.push_back(r);
+  }
+  return cmmPointsFromRows(path, "cmm", rows, cf >= 0, m);
 }
 
 TtpPoints readTtpOnMachine(const std::string& path, const std::string& text, const std::string& format,

@@ -1,5 +1,7 @@
 #include "planner/test_piece.hpp"
 
+#include "planner/cmm_plan.hpp"
+
 #include <cstdio>
 #include <cmath>
 #include <filesystem>
@@ -49,6 +51,7 @@ TestPiecePlan sphere(const parts::SphereArtifact& a, const parts::Machine& m, pa
   const double T = plan.cycle_time.total();
   p.duration_s = plan.manifest.cycles * T + (plan.manifest.cycles - 1) * plan.manifest.gap_s;
   out.programs.push_back(p);
+  out.files.emplace_back(kQifProbePlanFile, qifSphereProbePlan(plan.manifest));
   // The planner part of `probeloop plan`'s report (unchanged since the sphere cycle came).
   std::ostringstream s;
   const auto& t = plan.cycle_time;
@@ -62,6 +65,7 @@ TestPiecePlan sphere(const parts::SphereArtifact& a, const parts::Machine& m, pa
     << printf1("  rapids       %6.1f s\n", t.rapid_s) << printf1("  protected    %6.1f s\n", t.protected_s)
     << printf1("  probing      %6.1f s\n", t.probing_s);
   s << "  (no acceleration; see docs/sphere-cycle.md for the comparison with 95 s)\n";
+  s << "  the probing plan as QIF 3.0: " << join(out_dir, kQifProbePlanFile) << "\n";
   out.summary = s.str();
   out.manifest = std::move(plan.manifest);
   return out;
@@ -108,6 +112,7 @@ TestPiecePlan thermal(const parts::TestPiece& piece, const parts::ThermalTestPie
   out.programs = plannedPrograms(plan.programs, plan.start_s, plan.duration_s, dialect);
   const auto& man = plan.manifest;
   out.files.emplace_back(man.ttp.cmm_plan, plan.cmm_points_csv);
+  out.files.emplace_back(kQifCmmPlanFile, qifCmmPlan(man, plan.cmm_points_csv));
 
   std::ostringstream s;
   s << "Planned the thermal test piece (seed 004 Ch. 7) for " << m.name << " (" << parts::dialectName(dialect)
@@ -156,10 +161,10 @@ TestPiecePlan thermal(const parts::TestPiece& piece, const parts::ThermalTestPie
   s << "Inspection: " << man.points.size() << " points (TOP " << per["TOP"] << ", FLANK_P " << per["FLANK_P"] << ", FLANK_N "
     << per["FLANK_N"] << ", CYL " << per["CYL"] << ", " << t.z_paths << " Z paths x " << per[parts::zPathId(1)] << ", "
     << 4 * t.facets_per_segment << " facets x " << per[parts::facetId(parts::FacetSide::X1, 1)]
-    << "); the CMM measures the same points (" << man.ttp.cmm_plan << ")\n";
+    << "); the CMM measures the same points (" << man.ttp.cmm_plan << ", as QIF 3.0 " << kQifCmmPlanFile << ")\n";
   s << "  wrote";
   for (const auto& p : out.programs) s << " " << join(out_dir, p.file) << ",";
-  s << " " << join(out_dir, man.ttp.cmm_plan) << " and " << join(out_dir, "plan.json") << "\n";
+  s << " " << join(out_dir, man.ttp.cmm_plan) << ", " << join(out_dir, kQifCmmPlanFile) << " and " << join(out_dir, "plan.json") << "\n";
   s << "  (planned with the simulator's clock, no acceleration: docs/simulator.md §2, docs/thermal-test-piece.md §5)\n";
   out.summary = s.str();
   out.manifest = std::move(plan.manifest);
@@ -185,6 +190,7 @@ TestPiecePlan stepped(const parts::SteppedWorkpiece& w, const std::string& exper
   out.programs = plannedPrograms(plan.programs, plan.start_s, plan.duration_s, dialect);
   const auto& man = plan.manifest;
   out.files.emplace_back(man.sw.cmm_plan, plan.cmm_points_csv);
+  out.files.emplace_back(kQifCmmPlanFile, qifCmmPlan(man, plan.cmm_points_csv));
   const auto* e = w.experiment(experiment);
   std::ostringstream s;
   std::string sizes;
@@ -218,7 +224,7 @@ TestPiecePlan stepped(const parts::SteppedWorkpiece& w, const std::string& exper
       << " rpm, cut " << hms(st.start_s) << " - " << hms(st.end_s) << ", T = " << formatNumber(st.temp_state_min, 2) << " min\n";
   s << "  wrote";
   for (const auto& p : out.programs) s << " " << join(out_dir, p.file) << ",";
-  s << " " << join(out_dir, man.sw.cmm_plan) << " and " << join(out_dir, "plan.json") << "\n";
+  s << " " << join(out_dir, man.sw.cmm_plan) << ", " << join(out_dir, kQifCmmPlanFile) << " and " << join(out_dir, "plan.json") << "\n";
   s << "  (planned with the simulator's clock, no acceleration: docs/simulator.md §2, docs/stepped-workpiece.md §4)\n";
   out.summary = s.str();
   out.manifest = std::move(plan.manifest);

@@ -33,10 +33,12 @@ TEST(PlanTestPiece, TheSphereArtifactIsPlannedByTheSphereCycleByteForByte) {
       EXPECT_EQ(plan.programs[0].file, files.program_file);
       EXPECT_EQ(plan.programs[0].text, programText(ref, d));
       EXPECT_EQ(parts::manifestToJson(plan.manifest), parts::manifestToJson(ref.manifest));
-      EXPECT_TRUE(plan.files.empty());
+      ASSERT_EQ(plan.files.size(), 1u);
+      EXPECT_EQ(plan.files[0].first, "probe_plan.qif");
       EXPECT_EQ(plan.summary.rfind("Planned " + std::to_string(ref.manifest.cycles) + " cycles of the sphere cycle for " + m.name, 0), 0u);
       EXPECT_NE(plan.summary.find("  wrote out/" + files.program_file + " and out/plan.json\n"), std::string::npos) << plan.summary;
-      const std::string tail = "  (no acceleration; see docs/sphere-cycle.md for the comparison with 95 s)\n";
+      const std::string tail = "  (no acceleration; see docs/sphere-cycle.md for the comparison with 95 s)\n"
+                               "  the probing plan as QIF 3.0: out/probe_plan.qif\n";
       EXPECT_EQ(plan.summary.substr(plan.summary.size() - tail.size()), tail);
       EXPECT_NEAR(plan.programs[0].duration_s,
                   ref.manifest.cycles * ref.cycle_time.total() + (ref.manifest.cycles - 1) * ref.manifest.gap_s, 1e-9);
@@ -78,8 +80,9 @@ TEST(PlanTestPiece, TheSteppedWorkpieceIsPlannedPerExperiment) {
   ASSERT_EQ(plan.programs.size(), 3u);
   EXPECT_EQ(plan.programs[0].file, "roughing.nc");
   EXPECT_EQ(plan.programs[2].file, "probing.nc");
-  ASSERT_EQ(plan.files.size(), 1u);
+  ASSERT_EQ(plan.files.size(), 2u);
   EXPECT_EQ(plan.files[0].first, "cmm_points.csv");
+  EXPECT_EQ(plan.files[1].first, "cmm_plan.qif");
   EXPECT_EQ(plan.manifest.kind, "stepped_workpiece");
   for (const char* s : {"Planned experiment W8", "O3002", "step 4: feed XY 800 / Z 800 mm/min, 3500 rpm", "T = "})
     EXPECT_NE(plan.summary.find(s), std::string::npos) << s << "\n" << plan.summary;
@@ -110,11 +113,17 @@ TEST(PlanTestPiece, TheThermalTestPieceGivesThreeProgramsTheCmmPlanAndASummary) 
   }
   EXPECT_EQ(plan.manifest.programs[2].log_file, "ttp_probe.log");
   EXPECT_EQ(plan.manifest.programs[0].log_file, "");
-  ASSERT_EQ(plan.files.size(), 1u);
+  ASSERT_EQ(plan.files.size(), 2u);
   EXPECT_EQ(plan.files[0].first, "cmm_points.csv");
   EXPECT_NE(plan.files[0].second.find("feature,point,x_mm,y_mm,z_mm,nx,ny,nz\nTOP,1,"), std::string::npos);
+  EXPECT_EQ(plan.files[1].first, "cmm_plan.qif");
+  // The datum band CYL is a boss (its outward normals point away from the axis); the QIF plan
+  // names every feature of the CSV (checked against the schema in tests/integration/qif_cli.py).
+  EXPECT_NE(plan.files[1].second.find("<InternalExternal>EXTERNAL</InternalExternal>"), std::string::npos);
+  EXPECT_EQ(plan.files[1].second.find("INTERNAL"), std::string::npos);
+  EXPECT_NE(plan.files[1].second.find("<FeatureName>X2_9</FeatureName>"), std::string::npos);
   for (const char* s : {"45 measurement surfaces: 9 Z paths (12 mm pitch) + 36 facets (4 x 9, 6 deg pitch)",
-                        "8 waits of 3600 s + 9 cutting cycles", "Inspection: 364 points", "plan/cmm_points.csv and plan/plan.json",
+                        "8 waits of 3600 s + 9 cutting cycles", "Inspection: 364 points", "plan/cmm_points.csv, plan/cmm_plan.qif and plan/plan.json",
                         "C at 1200 rpm (180 x 200 turns forward and back)"})
     EXPECT_NE(plan.summary.find(s), std::string::npos) << s << "\n" << plan.summary;
   // The LinuxCNC dialect of the same machine: .ngc files, the inspection log opened by name.

@@ -7,6 +7,8 @@
 #include "core/atomic_file.hpp"
 #include "core/csv.hpp"
 #include "core/error.hpp"
+#include "geometry/least_squares.hpp"
+#include "interop/qif.hpp"
 #include "sim/material_removal.hpp"
 #include "sim/random_streams.hpp"
 
@@ -38,8 +40,80 @@ std::vector<CmmPoint> readCmmPoints(const std::string& path) {
   return out;
 }
 
+std::vector<CmmPoint> cmmPointsOfQifPlan(const interop::CmmDocument& plan) {
+  std::vector<CmmPoint> out;
+  for (const auto& f : plan.features) {
+    if (f.name.empty()) throw InputError(plan.file, f.line, "a feature nominal without a Name (the export names each point's feature)");
+    int k = 0;
+    for (const auto& q : f.points) {
+      CmmPoint p;
+      p.feature = f.name;
+      p.point = ++k;
+      p.line = f.line;
+      p.nominal_mm = q.p_mm;
+      p.normal = q.normal;
+      if (!(p.normal.norm() > 0))
+        throw InputError(plan.file, f.line, "feature " + f.name + " point " + std::to_string(k) + ": no Normal (the CMM approaches along it)");
+      out.push_back(p);
+    }
+  }
+  if (out.empty()) throw InputError(plan.file, 0, "no planned points (NominalPointSets) to measure");
+  return out;
+}
+
+std::string cmmResultsQif(const interop::CmmDocument& plan, const std::vector<Eigen::Vector3d>& measured_mm) {
+  interop::CmmDocument r = plan;
+  std::size_t i = 0;
+  for (auto& f : r.features) {
+    geometry::Points3 pts;
+    for (auto& p : f.points) {
+      p.p_mm = measured_mm.at(i++);
+      pts.push_back(p.p_mm);
+    }
+    geometry::ElementKind kind;
+    switch (f.kind) {
+      case interop::CmmFeatureKind::Plane: kind = geometry::ElementKind::Plane; break;
+      case interop::CmmFeatureKind::Sphere: kind = geometry::ElementKind::Sphere; break;
+      case interop::CmmFeatureKind::Cylinder: kind = geometry::ElementKind::Cylinder; break;
+      default: continue;
+    }
+    try {
+      geometry::LeastSquaresOptions o;
+      if (f.kind != interop::CmmFeatureKind::Plane) {  // start from the nominal
+        geometry::Element e;
+        e.kind = kind;
+        e.position_mm = f.nominal.location_mm;
+        e.direction = f.nominal.direction.norm() > 0 ? f.nominal.direction : Eigen::Vector3d::UnitZ();
+        e.radius_mm = f.nominal.diameter_mm / 2;
+        o.start = e;
+      }
+      geometry::FitResult fit;
+      try {
+        fit = geometry::fitLeastSquares(kind, pts, o);
+      } catch (const GeometryError&) {
+        // A cylinder probed in one section (the thermal test piece's datum band): its circle,
+        // the axis through the centre along the circle's normal, as CMM software reports it.
+        if (kind != geometry::ElementKind::Cylinder) throw;
+        fit = geometry::fitLeastSquares(geometry::ElementKind::Circle3D, pts);
+      }
+      auto& g = f.measured;
+      g.given = true;
+      g.location_mm = fit.element.position_mm;
+      g.direction = fit.element.direction;
+      // A plane's normal outward, like the nominal's; a cylinder's axis the nominal's way.
+      if (f.nominal.direction.norm() > 0 && g.direction.dot(f.nominal.direction) < 0) g.direction = -g.direction;
+      g.diameter_mm = 2 * fit.element.radius_mm;
+      g.form_mm = fit.form_mm;
+    } catch (const GeometryError&) {
+      // Too few or degenerate points for the element: the points go out without geometry.
+    }
+  }
+  return interop::qifResults(r);
+}
+
 std::string measureOnCmm(const Stock& stock, const parts::Workpiece& w, const std::vector<CmmPoint>& points,
-                         const std::string& file, std::uint64_t seed, double alpha_per_K, double search) {
+                         const std::string& file, std::uint64_t seed, double alpha_per_K, double search,
+                         std::vector<Eigen::Vector3d>* measured_mm) {
   std::mt19937_64 rng(seed ^ 0xC3A5C85C97CB3127ULL);
   std::normal_distribution<double> normal(0.0, 1.0);
   const double half_K = w.cmm.temperature_half_width_K;
@@ -74,6 +148,9 @@ std::string measureOnCmm(const Stock& stock, const parts::Workpiece& w, const st
     Eigen::Vector3d surface = from - *s * p.normal;
     if (half_K > 0) surface = w.datum() + scale * (surface - w.datum());
     const Eigen::Vector3d m = surface + (mpe_um / 2) * 1e-3 * normal(rng) * p.normal;
+    // The export's 0.1 um: QIF and CSV carry the same numbers.
+    if (measured_mm)
+      measured_mm->emplace_back(std::stod(formatNumber(m.x(), 4)), std::stod(formatNumber(m.y(), 4)), std::stod(formatNumber(m.z(), 4)));
     o << p.feature << "," << p.point << "," << formatNumber(m.x(), 4) << "," << formatNumber(m.y(), 4) << ","
       << formatNumber(m.z(), 4) << "," << formatNumber(p.normal.x(), 6) << "," << formatNumber(p.normal.y(), 6) << ","
       << formatNumber(p.normal.z(), 6) << "\n";

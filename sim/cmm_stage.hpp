@@ -12,7 +12,7 @@
 // measured point is scaled about the datum by 1 + alpha dT: a CMM that does not correct the
 // part's expansion (the evaluation's budget carries it as seed 004 Eq. 7.6). The drawn dT is
 // printed in the export's comment line; with half width 0 nothing is drawn and the export
-// is what it always was.
+// is what it always was. measured_mm, when given, receives each point's measured position.
 #pragma once
 #include <Eigen/Dense>
 #include <cstdint>
@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "interop/cmm_document.hpp"
 #include "parts/workpiece.hpp"
 
 namespace probeloop::sim {
@@ -35,10 +36,23 @@ struct CmmPoint {
 };
 
 std::vector<CmmPoint> readCmmPoints(const std::string& path);
+// A QIF 3.0 plan (interop/qif.hpp readQifPlan) as the CMM's points: each feature's planned
+// points in order, numbered from 1, line = the feature nominal's line; a point without its
+// Normal is refused (the CMM approaches along it).
+std::vector<CmmPoint> cmmPointsOfQifPlan(const interop::CmmDocument& plan);
 
 // alpha_per_K: the part's real expansion coefficient (NaN: the workpiece material's).
 std::string measureOnCmm(const Stock& stock, const parts::Workpiece& w, const std::vector<CmmPoint>& points,
                          const std::string& points_file, std::uint64_t seed,
-                         double alpha_per_K = std::numeric_limits<double>::quiet_NaN(), double search_mm = 5.0);
+                         double alpha_per_K = std::numeric_limits<double>::quiet_NaN(), double search_mm = 5.0,
+                         std::vector<Eigen::Vector3d>* measured_mm = nullptr);
+
+// The CMM's QIF 3.0 Results for a QIF plan: the plan's features (nominals kept) with their
+// measured points (in the plan's order, the plan's outward normals) and the least-squares
+// geometry of each (plane, sphere, cylinder; its form = the fit's range of residuals), as
+// CMM software reports them; a cylinder probed in one section gets its circle's (centre on the
+// axis, the circle's normal as the axis). A feature whose points fix no element keeps its
+// points without geometry.
+std::string cmmResultsQif(const interop::CmmDocument& plan, const std::vector<Eigen::Vector3d>& measured_mm);
 
 }  // namespace probeloop::sim

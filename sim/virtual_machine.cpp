@@ -1380,8 +1380,12 @@ SimulationOutputs simulatePrograms(const std::vector<ProgramSource>& programs, c
   out.trace_csv = vm.traceText();
   if (part.workpiece) {
     out.cuts_json = vm.cutsJson();
-    if (!part.cmm_points.empty())
-      out.cmm_csv = measureOnCmm(vm.stock(), *part.workpiece, part.cmm_points, part.cmm_points_file, seed, vm.partAlphaPerK());
+    if (!part.cmm_points.empty()) {
+      std::vector<Eigen::Vector3d> measured;
+      out.cmm_csv = measureOnCmm(vm.stock(), *part.workpiece, part.cmm_points, part.cmm_points_file, seed, vm.partAlphaPerK(), 5.0,
+                                 &measured);
+      if (part.cmm_qif_plan) out.cmm_qif = cmmResultsQif(*part.cmm_qif_plan, measured);
+    }
   }
 
   out.inputs_csv = vm.inputsText();

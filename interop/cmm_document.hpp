@@ -1,0 +1,69 @@
+// What a CMM exchange document holds, independent of its format (QIF 3.0 now, DMIS next): the
+// features of a test piece with their nominal or measured geometry and their points, and named
+// derived values (characteristics). The planner fills one as a plan, the simulated CMM and the
+// evaluation as results; the readers of other software's files return one.
+//
+// Conventions: lengths in mm in the document's frame (the part frame for our test pieces);
+// a point's normal points away from the material (QIF's MeasurePoint/Normal, our
+// cmm_points.csv nx,ny,nz), so a probe approaches along -normal; directions are unit vectors.
+#pragma once
+#include <Eigen/Dense>
+#include <cmath>
+#include <string>
+#include <vector>
+
+namespace probeloop::interop {
+
+// The kinds we write; a reader also reports the others it meets (Other, with the format's name).
+enum class CmmFeatureKind { Plane, Sphere, Cylinder, Circle, Point, Line, Other };
+const char* cmmFeatureKindName(CmmFeatureKind k);  // plane, sphere, cylinder, circle, point, line, other
+
+struct CmmPoint {
+  Eigen::Vector3d p_mm = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // zero: not given
+};
+
+// Plane: a point on it and its outward normal; sphere, circle: the centre (circle: the normal
+// of its plane); cylinder: a point on the axis and the axis; point: the point; line: a point
+// and its direction.
+struct CmmGeometry {
+  bool given = false;
+  Eigen::Vector3d location_mm = Eigen::Vector3d::Zero();
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();
+  double diameter_mm = NAN;  // sphere, cylinder, circle
+  double form_mm = NAN;      // measured form, when known
+};
+
+struct CmmFeature {
+  std::string name;  // our feature id (the manifest's); a reader: the file's feature name
+  CmmFeatureKind kind = CmmFeatureKind::Plane;
+  std::string kind_name;  // the format's own name (e.g. QIF "OppositeParallelLines"), for Other
+  bool internal = false;  // sphere, cylinder, circle: a bore (material outside)
+  CmmGeometry nominal;    // a plan's, and the Features section of results
+  CmmGeometry measured;   // results
+  std::vector<CmmPoint> points;  // planned (a plan) or measured (results)
+  // Reading only: where the feature stands in the file, and which measurement run it is in.
+  int line = 0;
+  int run = 0;
+};
+
+// A derived value (e.g. EX0C), a length in mm or an angle in rad, with its combined standard
+// uncertainty (NaN: none).
+struct CmmCharacteristic {
+  std::string name;
+  bool angular = false;
+  double value = 0, u = NAN;
+};
+
+struct CmmDocument {
+  std::string file;       // reading: the path, for messages
+  std::string part_name;  // writing: said in the document's header
+  std::vector<CmmFeature> features;
+  std::vector<CmmCharacteristic> characteristics;
+  // Reading: the file's own length unit and what was passed over (one line each).
+  std::string length_unit = "mm";
+  int runs = 0;
+  std::vector<std::string> notes;
+};
+
+}  // namespace probeloop::interop

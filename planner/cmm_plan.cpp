@@ -1,0 +1,84 @@
+#include "planner/cmm_plan.hpp"
+
+#include <map>
+#include <stdexcept>
+
+#include "core/csv.hpp"
+#include "interop/qif.hpp"
+
+namespace probeloop::planner {
+
+using Eigen::Vector3d;
+
+std::string qifCmmPlan(const parts::PlanManifest& m, const std::string& cmm_points_csv) {
+  const CsvTable t = parseCsv(cmm_points_csv, "cmm_points.csv");
+  const int cf = t.column("feature"), cx = t.column("x_mm"), cy = t.column("y_mm"), cz = t.column("z_mm"), nx = t.column("nx"),
+            ny = t.column("ny"), nz = t.column("nz");
+  interop::CmmDocument d;
+  d.part_name = m.part_name;
+  std::map<std::string, std::size_t> index;
+  for (const auto& r : t.rows) {
+    const std::string& id = r.fields[static_cast<std::size_t>(cf)];
+    auto it = index.find(id);
+    if (it == index.end()) {
+      const auto* mf = m.feature(id);
+      if (!mf) throw std::logic_error("CMM plan: feature " + id + " is not in the manifest");
+      const auto& n = mf->nominal;
+      interop::CmmFeature f;
+      f.name = id;
+      f.nominal.given = true;
+      f.nominal.location_mm = n.point_mm;
+      f.nominal.direction = n.direction;
+      if (n.kind == "plane") {
+        f.kind = interop::CmmFeatureKind::Plane;
+      } else if (n.kind == "cylinder") {
+        f.kind = interop::CmmFeatureKind::Cylinder;
+        f.nominal.diameter_mm = 2 * n.radius_mm;
+      } else if (n.kind == "sphere") {
+        f.kind = interop::CmmFeatureKind::Sphere;
+        f.nominal.diameter_mm = 2 * n.radius_mm;
+      } else {
+        throw std::logic_error("CMM plan: feature " + id + " of kind " + n.kind);
+      }
+      it = index.emplace(id, d.features.size()).first;
+      d.features.push_back(f);
+    }
+    interop::CmmPoint p;
+    p.p_mm = Vector3d(t.number(r, cx), t.number(r, cy), t.number(r, cz));
+    p.normal = Vector3d(t.number(r, nx), t.number(r, ny), t.number(r, nz));
+    d.features[it->second].points.push_back(p);
+  }
+  // A bore's outward normals point to its axis (the material is outside).
+  for (auto& f : d.features) {
+    if (f.kind != interop::CmmFeatureKind::Cylinder || f.points.empty()) continue;
+    const auto& p = f.points.front();
+    const Vector3d a = p.p_mm - f.nominal.location_mm;
+    const Vector3d radial = a - a.dot(f.nominal.direction) * f.nominal.direction;
+    f.internal = radial.dot(p.normal) < 0;
+  }
+  return interop::qifPlan(d);
+}
+
+std::string qifSphereProbePlan(const parts::PlanManifest& m) {
+  interop::CmmDocument d;
+  d.part_name = "sphere artifact";
+  for (const auto& s : m.spheres) {
+    interop::CmmFeature f;
+    f.name = s.id;
+    f.kind = interop::CmmFeatureKind::Sphere;
+    f.nominal.given = true;
+    f.nominal.location_mm = s.nominal_centre_mm;
+    f.nominal.diameter_mm = 2 * m.sphere_radius_mm;
+    for (const auto& p : m.points) {
+      if (p.position != s.position) continue;
+      interop::CmmPoint q;
+      q.p_mm = p.contact_mm + m.tip_radius_mm * p.approach;
+      q.normal = -p.approach;
+      f.points.push_back(q);
+    }
+    d.features.push_back(f);
+  }
+  return interop::qifPlan(d);
+}
+
+}  // namespace probeloop::planner

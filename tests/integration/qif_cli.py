@@ -1,0 +1,189 @@
+#!/usr/bin/env python3
+"""QIF 3.0 through the real CLI (issue 15 items 1-2):
+
+- every QIF file probeloop writes validates with xmllint against the QIF 3.0.0 XSD of
+  ../shared/refdata/qif3: the CMM plans of the thermal test piece and of the stepped workpiece,
+  the sphere artifact's probing plan, and the simulated CMM's results;
+- the round trip: plan -> cmm_plan.qif -> the simulated CMM reading it -> cmm_results.qif ->
+  evaluate gives the same errors.csv as the CSV route (cmm_export.csv), every printed digit
+  (thermal test piece; stepped workpiece W8 with its probe log);
+- other software's samples (refdata/qif3/samples) read with the counts and coordinates that
+  `xmllint --xpath` gives for them, computed here, independently of probeloop;
+- bad input: a QIF file of another version, and a point set whose count does not match its
+  points, are refused naming the file, the line and the field, and nothing is written.
+
+Needs $PROBELOOP, $PROBELOOP_SOURCE_DIR and xmllint (libxml2-utils)."""
+import json, os, re, subprocess, sys, tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402
+
+PL = os.environ["PROBELOOP"]
+SRC = os.environ["PROBELOOP_SOURCE_DIR"]
+QIF = os.path.join(SRC, "..", "shared", "refdata", "qif3")
+XSD = os.path.join(QIF, "QIFApplications", "QIFDocument.xsd")
+W = tempfile.mkdtemp(prefix="probeloop-qif-")
+check = Checks()
+
+
+def run(*args, cwd=None):
+    p = subprocess.run([PL, *args], capture_output=True, text=True, cwd=cwd)
+    return p.returncode, p.stdout, p.stderr
+
+
+def valid(path):
+    p = subprocess.run(["xmllint", "--noout", "--nonet", "--schema", XSD, path], capture_output=True, text=True)
+    return p.returncode == 0, p.stderr[-600:]
+
+
+def xpath(path, expr):
+    p = subprocess.run(["xmllint", "--xpath", expr, path], capture_output=True, text=True)
+    return p.stdout.strip()
+
+
+def L(name):
+    return f"*[local-name()='{name}']"
+
+
+def numbers(errors_csv):
+    return [l for l in open(errors_csv) if not l.startswith("#")]
+
+
+if not os.path.exists(XSD):
+    check(f"the QIF 3.0 schemas are at {XSD}", False)
+    check.finish()
+
+# --- the thermal test piece: plan, CMM from the QIF plan, both routes ---------------------------
+T = f"{W}/ttp"
+code, out, err = run("plan", f"{SRC}/parts/thermal_test_piece.yaml", "--machine", f"{SRC}/parts/machines/nmv5000.yaml", "--out", f"{T}/plan")
+check("plan the thermal test piece", code == 0 and "cmm_plan.qif" in out, err)
+ok, e = valid(f"{T}/plan/cmm_plan.qif")
+check("the thermal test piece's cmm_plan.qif validates against the QIF 3.0 XSD", ok, e)
+csv_points = sum(1 for l in open(f"{T}/plan/cmm_points.csv") if l[:1].isalpha() and not l.startswith("feature,"))
+n_qif = xpath(f"{T}/plan/cmm_plan.qif", f"count(//{L('NominalPointSet')}/{L('MeasurePoint')})")
+check(f"cmm_plan.qif holds the {csv_points} points of cmm_points.csv (xmllint: {n_qif})", n_qif == str(csv_points))
+wait = os.environ.get("TTP_WAIT")
+piece = f"{SRC}/parts/thermal_test_piece.yaml"
+if wait:  # under the sanitizers: shorter waits (the same programs and checks)
+    text = open(piece).read()
+    piece = f"{W}/ttp.yaml"
+    open(piece, "w").write(re.sub(r"(\n\s*wait: )[^\n#]*", rf"\g<1>{wait}", text, count=1))
+    run("plan", piece, "--machine", f"{SRC}/parts/machines/nmv5000.yaml", "--out", f"{T}/plan")
+code, out, err = run("simulate", "pre_machining.nc", "thermal_test.nc", "inspection.nc", "--machine", f"{SRC}/parts/machines/nmv5000.yaml",
+                     "--part", piece, "--truth", f"{SRC}/examples/truth_thermal_test.yaml", "--cmm-points", "cmm_plan.qif",
+                     "--out", f"{T}/run", cwd=f"{T}/plan")
+check("simulate with the CMM reading cmm_plan.qif: cmm_export.csv and cmm_results.qif", code == 0 and "cmm_results.qif" in out, err)
+if code == 0:
+    ok, e = valid(f"{T}/run/cmm_results.qif")
+    check("the simulated CMM's cmm_results.qif validates against the QIF 3.0 XSD", ok, e)
+    pts = xpath(f"{T}/run/cmm_results.qif", f"sum(//{L('MeasuredPointSet')}/@count)")
+    check(f"cmm_results.qif holds every measured point ({pts})", pts == str(csv_points))
+    c1, _, e1 = run("evaluate", f"{T}/run/cmm_export.csv", "--manifest", f"{T}/plan/plan.json", "--out", f"{T}/ev-csv")
+    c2, out2, e2 = run("evaluate", f"{T}/run/cmm_results.qif", "--manifest", f"{T}/plan/plan.json", "--out", f"{T}/ev-qif")
+    check("evaluate the CSV export and the QIF results", c1 == 0 and c2 == 0 and "assigned by labels" in out2, e1 + e2)
+    if c1 == 0 and c2 == 0:
+        a, b = numbers(f"{T}/ev-csv/errors.csv"), numbers(f"{T}/ev-qif/errors.csv")
+        check(f"the QIF route gives the CSV route's errors.csv, every printed digit ({len(a) - 1} cycles)", a == b and len(a) > 2,
+              next((f"{x.strip()} | {y.strip()}" for x, y in zip(a, b) if x != y), "row count"))
+    code, out, err = run("read", f"{T}/run/cmm_results.qif", "--json")
+    d = json.loads(out) if code == 0 else {}
+    cyl = [f for f in d.get("features", []) if f["name"] == "CYL"]
+    check("probeloop read: the datum band CYL as a measured cylinder with its least-squares diameter",
+          len(cyl) == 1 and cyl[0]["kind"] == "cylinder" and abs(cyl[0]["measured"]["diameter_mm"] - cyl[0]["nominal"]["diameter_mm"]) < 0.05,
+          err or cyl)
+
+    # Bad input: another version; a point set whose count is not its points'.
+    text = open(f"{T}/run/cmm_results.qif").read()
+    open(f"{W}/v2.qif", "w").write(text.replace('versionQIF="3.0.0"', 'versionQIF="2.1.0"'))
+    code, _, err = run("evaluate", f"{W}/v2.qif", "--manifest", f"{T}/plan/plan.json", "--out", f"{W}/bad-v2")
+    check("a QIF file of another version is refused naming file, line and field, nothing written",
+          code != 0 and "v2.qif:2: versionQIF: '2.1.0'" in err and not os.path.exists(f"{W}/bad-v2"), err)
+    m = re.search(r'<MeasuredPointSet id="(\d+)" count="(\d+)"', text)
+    bad = text.replace(m.group(0), f'<MeasuredPointSet id="{m.group(1)}" count="{int(m.group(2)) + 1}"', 1)
+    open(f"{W}/count.qif", "w").write(bad)
+    line = bad[: bad.index("<Points>", bad.index(m.group(1) + '" count'))].count("\n") + 1
+    code, _, err = run("evaluate", f"{W}/count.qif", "--manifest", f"{T}/plan/plan.json", "--out", f"{W}/bad-count")
+    check(f"a point set whose count is not its points' is refused at line {line}",
+          code != 0 and f"count.qif:{line}: Points: " in err and not os.path.exists(f"{W}/bad-count"), err)
+
+# --- the stepped workpiece W8: the CMM's QIF results with the probe log ---------------------------
+S = f"{W}/w8"
+code, out, err = run("plan", f"{SRC}/parts/stepped_workpiece.yaml", "--machine", f"{SRC}/parts/machines/vmc3.yaml", "--out", f"{S}/plan",
+                     "--experiment", "W8")
+check("plan W8", code == 0, err)
+ok, e = valid(f"{S}/plan/cmm_plan.qif")
+check("W8's cmm_plan.qif validates against the QIF 3.0 XSD", ok, e)
+code, out, err = run("simulate", "roughing.ngc", "finishing.ngc", "probing.ngc", "--machine", f"{SRC}/parts/machines/vmc3.yaml",
+                     "--part", f"{SRC}/parts/stepped_workpiece.yaml", "--truth", f"{SRC}/examples/stepped_workpiece/truth.yaml",
+                     "--cmm-points", "cmm_plan.qif", "--schedule", "plan.json", "--out", f"{S}/run", cwd=f"{S}/plan")
+check("simulate W8 with the CMM reading cmm_plan.qif", code == 0 and "cmm_results.qif" in out, err)
+if code == 0:
+    ok, e = valid(f"{S}/run/cmm_results.qif")
+    check("W8's cmm_results.qif validates against the QIF 3.0 XSD", ok, e)
+    args = ["--probe-log", f"{S}/run/sw_probe.log", "--manifest", f"{S}/plan/plan.json"]
+    c1, _, e1 = run("evaluate", f"{S}/run/cmm_export.csv", *args, "--out", f"{S}/ev-csv")
+    c2, _, e2 = run("evaluate", f"{S}/run/cmm_results.qif", *args, "--out", f"{S}/ev-qif")
+    check("evaluate W8 from the CSV export and from the QIF results", c1 == 0 and c2 == 0, e1 + e2)
+    if c1 == 0 and c2 == 0:
+        a, b = numbers(f"{S}/ev-csv/errors.csv"), numbers(f"{S}/ev-qif/errors.csv")
+        check(f"W8: the QIF route gives the CSV route's errors.csv, every printed digit ({len(a) - 1} steps)", a == b and len(a) == 5)
+
+# --- the sphere artifact's probing plan ----------------------------------------------------------
+code, out, err = run("plan", f"{SRC}/parts/sphere_artifact.yaml", "--machine", f"{SRC}/parts/machines/nmv5000.yaml", "--out", f"{W}/sa")
+ok, e = valid(f"{W}/sa/probe_plan.qif")
+check("the sphere artifact's probe_plan.qif validates against the QIF 3.0 XSD", code == 0 and ok, err + e)
+if code == 0:
+    plan = json.load(open(f"{W}/sa/plan.json"))
+    code, out, err = run("read", f"{W}/sa/probe_plan.qif", "--json")
+    d = json.loads(out) if code == 0 else {"features": []}
+    worst = 0.0
+    for f in d["features"]:
+        c = f["nominal"]["location_mm"]
+        rad = f["nominal"]["diameter_mm"] / 2
+        for p in f["points_mm"]:
+            worst = max(worst, abs(sum((p[i] - c[i]) ** 2 for i in range(3)) ** 0.5 - rad))
+    check(f"every planned point of probe_plan.qif lies on its sphere's surface (worst {worst * 1e3:.4f} um; {len(d['features'])} spheres)",
+          len(d["features"]) == len(plan["features"]) and worst < 1e-5, err)
+
+# --- other software's samples: counts and coordinates as xmllint --xpath gives them ---------------
+S3 = os.path.join(QIF, "samples")
+MF = f"//{L('MeasuredFeatures')}/*"
+for name in sorted(os.listdir(S3)):
+    path = os.path.join(S3, name)
+    code, out, err = run("read", path, "--json")
+    if code != 0:
+        check(f"{name}: probeloop read", False, err)
+        continue
+    d = json.loads(out)
+    if int(float(xpath(path, f"count(//{L('Results')})") or 0)):
+        want = int(xpath(path, f"count({MF})"))
+        kinds = {}
+        for k in ("Plane", "Cylinder", "Circle", "Point", "EdgePoint", "Sphere"):
+            kinds[k] = int(xpath(path, f"count({MF}[local-name()='{k}FeatureMeasurement'])"))
+        got = {k: sum(1 for f in d["features"] if f["kind"] == k.lower()) for k in ("Plane", "Cylinder", "Circle", "Sphere")}
+        got_points = sum(1 for f in d["features"] if f["kind"] == "point")
+        pts_want = int(float(xpath(path, f"sum(//{L('MeasuredPointSet')}/@count)") or 0))
+        pts_got = sum(len(f["points_mm"]) for f in d["features"])
+        check(f"{name}: {len(d['features'])} measured features ({want} by xmllint), by kind {got} + {got_points} points "
+              f"(xmllint {kinds}), {pts_got} measured points ({pts_want})",
+              len(d["features"]) == want and all(got[k] == kinds[k] for k in got) and got_points == kinds["Point"] + kinds["EdgePoint"]
+              and pts_got == pts_want)
+        if want:
+            first = xpath(path, f"string(({MF})[1]/{L('Location')})")
+            item = xpath(path, f"string(({MF})[1]/{L('FeatureItemId')})")
+            fname = xpath(path, f"string(//{L('FeatureItems')}/*[@id='{item}']/{L('FeatureName')})")
+            loc = d["features"][0].get("measured", {}).get("location_mm")
+            check(f"{name}: the first feature is {fname} at {first} (xmllint)",
+                  d["features"][0]["name"] == fname and loc is not None
+                  and all(abs(a - float(b)) < 1e-9 for a, b in zip(loc, first.split())), d["features"][0])
+        if not int(float(xpath(path, f"count(/*/{L('FileUnits')})"))):
+            check(f"{name}: no FileUnits: read in mm with a note", "no FileUnits: lengths read in mm" in d["notes"], d["notes"])
+    else:
+        nominals = int(xpath(path, f"count(//{L('FeatureNominals')}/*)"))
+        check(f"{name}: no Results; read as a plan: {len(d['features'])} feature nominals ({nominals} by xmllint)",
+              len(d["features"]) == nominals)
+        cad = xpath(path, f"count(/*/{L('Product')}/{L('GeometrySet')}/{L('PointSet')}/{L('Point')})")
+        if cad != "0":
+            check(f"{name}: its {cad} PointSet points (xmllint) are named as CAD geometry, not measurements",
+                  any(f"PointSet of {cad} CAD points" in n for n in d["notes"]), d["notes"])
+check.finish()
