@@ -244,6 +244,7 @@ int cmdEvaluate(const std::string& points_file, const std::string& manifest_file
   writeFileAtomic(join(out_dir, evaluate::EvaluationFiles::kEvaluationJson), f.evaluation_json);
   writeFileAtomic(join(out_dir, evaluate::EvaluationFiles::kReportMd), f.report_md);
   if (!f.compensation_json.empty()) writeFileAtomic(join(out_dir, "compensation.json"), f.compensation_json);
+  if (!f.results_qif.empty()) writeFileAtomic(join(out_dir, evaluate::EvaluationFiles::kResultsQif), f.results_qif);
   std::fputs(f.stdout_text.c_str(), stdout);
   if (!scene.empty()) {
     writeFileAtomic(scene_file, scene);

@@ -4,8 +4,10 @@
 #include <cstdarg>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 
 #include "core/atomic_file.hpp"
+#include "evaluate/qif_results.hpp"
 #include "core/csv.hpp"
 #include "core/error.hpp"
 #include "evaluate/ingest.hpp"
@@ -47,6 +49,7 @@ EvaluationFiles sphere(const parts::PlanManifest& planned, const EvaluateRequest
   f.evaluation_json = evaluationJson(e, m);
   f.report_md = evaluationReport(e, m);
   f.stdout_text = sphereEvaluationStdout(e, r.out_dir);
+  f.results_qif = evaluationQif(m, nullptr, f.errors_csv);
   return f;
 }
 
@@ -57,10 +60,13 @@ EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateReq
   TtpOptions opt;
   opt.gauge_resolution_um = r.gauge_resolution_um;
   TtpEvaluation e;
+  std::optional<TtpPoints> points;
   if (fmt == "cmm" || fmt == "qif") {  // a CSV export or QIF 3.0 Results
-    e = evaluateThermalTestPiece(m, readTtpCmmExport(r.input_file, text, m), opt);
+    points = readTtpCmmExport(r.input_file, text, m);
+    e = evaluateThermalTestPiece(m, *points, opt);
   } else if (fmt == "linuxcnc" || fmt == "fanuc" || fmt == "log" || fmt == "csv") {
-    e = evaluateThermalTestPiece(m, readTtpOnMachine(r.input_file, text, fmt, m), opt);
+    points = readTtpOnMachine(r.input_file, text, fmt, m);
+    e = evaluateThermalTestPiece(m, *points, opt);
   } else if (fmt == "gauge") {
     if (!(r.gauge_resolution_um > 0)) throw InputError("", 0, "the gauge resolution must be positive");
     e = evaluateThermalTestPieceGauge(m, readTtpGauge(r.input_file, text, m), opt);
@@ -70,6 +76,7 @@ EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateReq
   if (!r.compare_with.empty()) e.comparison = compareSpans(e, r.compare_with);
   EvaluationFiles f;
   f.errors_csv = ttpErrorsCsv(e);
+  f.results_qif = evaluationQif(m, points ? &*points : nullptr, f.errors_csv);
   f.evaluation_json = ttpEvaluationJson(e);
   f.report_md = ttpReport(e);
   f.stdout_text = ttpStdout(e, join(r.out_dir, EvaluationFiles::kErrorsCsv), join(r.out_dir, EvaluationFiles::kEvaluationJson),
@@ -94,20 +101,24 @@ EvaluationFiles steppedWorkpiece(const parts::PlanManifest& m, const EvaluateReq
   if (log_fmt == "cmm" || log_fmt == "gauge" || log_fmt == "qif")
     throw InputError(r.probe_log, 0, "--probe-log: expected the on-machine probe log (PT lines) or points CSV, found a " + log_fmt + " file");
   EvaluationFiles f;
-  f.stepped_workpiece = evaluateSteppedWorkpiece(m, readTtpCmmExport(r.input_file, text, m), readTtpOnMachine(r.probe_log, log, log_fmt, m));
+  const auto cmm = readTtpCmmExport(r.input_file, text, m);
+  f.stepped_workpiece = evaluateSteppedWorkpiece(m, cmm, readTtpOnMachine(r.probe_log, log, log_fmt, m));
   if (!r.compare_with.empty()) compareWithBefore(*f.stepped_workpiece, m, r.compare_with);
   const auto& e = *f.stepped_workpiece;
   f.errors_csv = swErrorsCsv(e);
   f.evaluation_json = swEvaluationJson(e);
   f.report_md = swReport(e);
   f.compensation_json = swCompensationFile(e);
+  f.results_qif = evaluationQif(m, &cmm, f.errors_csv);
   f.stdout_text = swStdout(e, r.out_dir);
   return f;
 }
 
 }  // namespace
 
-EvaluationFiles evaluateTestPiece(const parts::PlanManifest& m, const EvaluateRequest& r) {
+namespace {
+
+EvaluationFiles evaluateByKind(const parts::PlanManifest& m, const EvaluateRequest& r) {
   if (m.kind == "sphere_artifact") {
     if (!r.compare_with.empty())
       throw InputError("", 0, "--compare applies to the thermal test piece (seed 004 Table 7.2), not to a sphere-artifact campaign");
@@ -120,6 +131,14 @@ EvaluationFiles evaluateTestPiece(const parts::PlanManifest& m, const EvaluateRe
   if (m.kind == "thermal_test_piece") return thermalTestPiece(m, r);
   if (m.kind == "stepped_workpiece") return steppedWorkpiece(m, r);
   throw InputError(m.file, 0, "manifest kind '" + m.kind + "': evaluate knows sphere_artifact, thermal_test_piece and stepped_workpiece");
+}
+
+}  // namespace
+
+EvaluationFiles evaluateTestPiece(const parts::PlanManifest& m, const EvaluateRequest& r) {
+  auto f = evaluateByKind(m, r);
+  if (!f.results_qif.empty()) f.stdout_text += "  the results as QIF 3.0: " + join(r.out_dir, EvaluationFiles::kResultsQif) + "\n";
+  return f;
 }
 
 std::string sphereEvaluationStdout(const CampaignEvaluation& e, const std::string& out_dir) {

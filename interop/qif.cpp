@@ -139,7 +139,7 @@ std::string contentKey(const CmmDocument& d, const char* what) {
     k << '|' << f.name << ',' << cmmFeatureKindName(f.kind) << ',' << point(f.nominal.location_mm) << ',' << f.points.size();
     for (const auto& p : f.points) k << ';' << point(p.p_mm);
   }
-  for (const auto& c : d.characteristics) k << '|' << c.name << ',' << fixed(c.value, 9);
+  for (const auto& c : d.characteristics) k << '|' << c.name << ',' << fixed(c.value, 12);
   return k.str();
 }
 
@@ -348,9 +348,11 @@ std::string qifResults(const CmmDocument& results) {
       w.id(e);
       w.add(w.add(e, "Status"), "CharacteristicStatusEnum", "NOT_ANALYZED");
       w.add(e, "CharacteristicItemId", std::to_string(cids[i].item));
-      auto* v = w.add(e, "Value", fixed(c.value, 9));
+      // 1e-9 mm, 1e-12 rad: below the printed digits of errors.csv (um, urad to 3 decimals)
+      const int digits = c.angular ? 12 : 9;
+      auto* v = w.add(e, "Value", fixed(c.value, digits));
       if (std::isfinite(c.u)) {  // the XSD: both attributes or neither
-        Writer::attr(v, "combinedUncertainty", fixed(c.u, 9));
+        Writer::attr(v, "combinedUncertainty", fixed(c.u, digits));
         Writer::attr(v, "meanError", "0");
       }
     }

@@ -11,7 +11,7 @@
 // written: plane, sphere, cylinder (others are refused with a logic_error: our planner makes
 // no others). Both validate against the QIF 3.0.0 XSD (tests with xmllint). Deterministic: the
 // QPId is a UUID made from a hash of the content; numbers in fixed notation (xs:decimal takes no
-// exponent), lengths to 1 nm, directions to 1e-9.
+// exponent), lengths to 1 nm, directions to 1e-9, characteristics to 1e-9 mm / 1e-12 rad.
 //
 // Reading: readQifResults parses a QIF 3 document (any producer, default namespace or a
 // prefix; no network) and returns every measured feature of every MeasurementResults with its

@@ -5,6 +5,7 @@
 
 #include "core/csv.hpp"
 #include "interop/qif.hpp"
+#include "parts/cmm_feature.hpp"
 
 namespace probeloop::planner {
 
@@ -23,39 +24,15 @@ std::string qifCmmPlan(const parts::PlanManifest& m, const std::string& cmm_poin
     if (it == index.end()) {
       const auto* mf = m.feature(id);
       if (!mf) throw std::logic_error("CMM plan: feature " + id + " is not in the manifest");
-      const auto& n = mf->nominal;
-      interop::CmmFeature f;
-      f.name = id;
-      f.nominal.given = true;
-      f.nominal.location_mm = n.point_mm;
-      f.nominal.direction = n.direction;
-      if (n.kind == "plane") {
-        f.kind = interop::CmmFeatureKind::Plane;
-      } else if (n.kind == "cylinder") {
-        f.kind = interop::CmmFeatureKind::Cylinder;
-        f.nominal.diameter_mm = 2 * n.radius_mm;
-      } else if (n.kind == "sphere") {
-        f.kind = interop::CmmFeatureKind::Sphere;
-        f.nominal.diameter_mm = 2 * n.radius_mm;
-      } else {
-        throw std::logic_error("CMM plan: feature " + id + " of kind " + n.kind);
-      }
       it = index.emplace(id, d.features.size()).first;
-      d.features.push_back(f);
+      d.features.push_back(parts::cmmFeatureOf(mf->nominal));
     }
     interop::CmmPoint p;
     p.p_mm = Vector3d(t.number(r, cx), t.number(r, cy), t.number(r, cz));
     p.normal = Vector3d(t.number(r, nx), t.number(r, ny), t.number(r, nz));
     d.features[it->second].points.push_back(p);
   }
-  // A bore's outward normals point to its axis (the material is outside).
-  for (auto& f : d.features) {
-    if (f.kind != interop::CmmFeatureKind::Cylinder || f.points.empty()) continue;
-    const auto& p = f.points.front();
-    const Vector3d a = p.p_mm - f.nominal.location_mm;
-    const Vector3d radial = a - a.dot(f.nominal.direction) * f.nominal.direction;
-    f.internal = radial.dot(p.normal) < 0;
-  }
+  for (auto& f : d.features) parts::setInternalFromPoints(f);
   return interop::qifPlan(d);
 }
 

@@ -7,7 +7,7 @@
 #include "core/atomic_file.hpp"
 #include "core/csv.hpp"
 #include "core/error.hpp"
-#include "geometry/least_squares.hpp"
+#include "interop/measured_geometry.hpp"
 #include "interop/qif.hpp"
 #include "sim/material_removal.hpp"
 #include "sim/random_streams.hpp"
@@ -65,48 +65,8 @@ std::string cmmResultsQif(const interop::CmmDocument& plan, const std::vector<Ei
   interop::CmmDocument r = plan;
   std::size_t i = 0;
   for (auto& f : r.features) {
-    geometry::Points3 pts;
-    for (auto& p : f.points) {
-      p.p_mm = measured_mm.at(i++);
-      pts.push_back(p.p_mm);
-    }
-    geometry::ElementKind kind;
-    switch (f.kind) {
-      case interop::CmmFeatureKind::Plane: kind = geometry::ElementKind::Plane; break;
-      case interop::CmmFeatureKind::Sphere: kind = geometry::ElementKind::Sphere; break;
-      case interop::CmmFeatureKind::Cylinder: kind = geometry::ElementKind::Cylinder; break;
-      default: continue;
-    }
-    try {
-      geometry::LeastSquaresOptions o;
-      if (f.kind != interop::CmmFeatureKind::Plane) {  // start from the nominal
-        geometry::Element e;
-        e.kind = kind;
-        e.position_mm = f.nominal.location_mm;
-        e.direction = f.nominal.direction.norm() > 0 ? f.nominal.direction : Eigen::Vector3d::UnitZ();
-        e.radius_mm = f.nominal.diameter_mm / 2;
-        o.start = e;
-      }
-      geometry::FitResult fit;
-      try {
-        fit = geometry::fitLeastSquares(kind, pts, o);
-      } catch (const GeometryError&) {
-        // A cylinder probed in one section (the thermal test piece's datum band): its circle,
-        // the axis through the centre along the circle's normal, as CMM software reports it.
-        if (kind != geometry::ElementKind::Cylinder) throw;
-        fit = geometry::fitLeastSquares(geometry::ElementKind::Circle3D, pts);
-      }
-      auto& g = f.measured;
-      g.given = true;
-      g.location_mm = fit.element.position_mm;
-      g.direction = fit.element.direction;
-      // A plane's normal outward, like the nominal's; a cylinder's axis the nominal's way.
-      if (f.nominal.direction.norm() > 0 && g.direction.dot(f.nominal.direction) < 0) g.direction = -g.direction;
-      g.diameter_mm = 2 * fit.element.radius_mm;
-      g.form_mm = fit.form_mm;
-    } catch (const GeometryError&) {
-      // Too few or degenerate points for the element: the points go out without geometry.
-    }
+    for (auto& p : f.points) p.p_mm = measured_mm.at(i++);
+    interop::fitMeasuredGeometry(f);
   }
   return interop::qifResults(r);
 }

@@ -6,7 +6,8 @@
   the sphere artifact's probing plan, and the simulated CMM's results;
 - the round trip: plan -> cmm_plan.qif -> the simulated CMM reading it -> cmm_results.qif ->
   evaluate gives the same errors.csv as the CSV route (cmm_export.csv), every printed digit
-  (thermal test piece; stepped workpiece W8 with its probe log);
+  (thermal test piece; stepped workpiece W8 with its probe log); the evaluation's results.qif
+  carries its errors with their u as characteristics and its measured features;
 - other software's samples (refdata/qif3/samples) read with the counts and coordinates that
   `xmllint --xpath` gives for them, computed here, independently of probeloop;
 - bad input: a QIF file of another version, and a point set whose count does not match its
@@ -85,6 +86,30 @@ if code == 0:
         a, b = numbers(f"{T}/ev-csv/errors.csv"), numbers(f"{T}/ev-qif/errors.csv")
         check(f"the QIF route gives the CSV route's errors.csv, every printed digit ({len(a) - 1} cycles)", a == b and len(a) > 2,
               next((f"{x.strip()} | {y.strip()}" for x, y in zip(a, b) if x != y), "row count"))
+        # The evaluation's own results.qif: valid, and its characteristics are errors.csv's values.
+        ok, e = valid(f"{T}/ev-qif/results.qif")
+        check("the evaluation's results.qif validates against the QIF 3.0 XSD", ok, e)
+        code, out, err = run("read", f"{T}/ev-qif/results.qif", "--json")
+        r = json.loads(out) if code == 0 else {"characteristics": [], "features": []}
+        chars = {c["name"]: c for c in r["characteristics"]}
+        import csv as _csv  # noqa: E402
+        rows = list(_csv.DictReader(l for l in open(f"{T}/ev-qif/errors.csv") if not l.startswith("#")))
+        worst, n = 0.0, 0
+        for row in rows:
+            for col in ("EX_um", "EY_um", "EZ_um", "ETTP_um", "EB_urad"):
+                c = chars.get(f"{col.rsplit('_', 1)[0]} cycle {row['cycle']}")
+                if c is None:
+                    worst = float("inf")
+                    continue
+                scale = 1e-6 if col.endswith("_urad") else 1e-3
+                worst = max(worst, abs(c["value"] - float(row[col]) * scale) / scale,
+                            abs(c["u"] - float(row["U_" + col]) / 2 * scale) / scale)
+                n += 1
+        check(f"results.qif carries E_X ... E_TTP of every cycle with u = U/2 ({n} values, worst difference {worst:.2g} um|urad)",
+              n == 5 * len(rows) and worst < 1e-6)
+        check(f"results.qif carries the {len(r['features'])} measured features with their points and fitted geometry",
+              len(r["features"]) == 49 and sum(len(f["points_mm"]) for f in r["features"]) == csv_points
+              and all("measured" in f for f in r["features"]), err)
     code, out, err = run("read", f"{T}/run/cmm_results.qif", "--json")
     d = json.loads(out) if code == 0 else {}
     cyl = [f for f in d.get("features", []) if f["name"] == "CYL"]
@@ -127,6 +152,12 @@ if code == 0:
     if c1 == 0 and c2 == 0:
         a, b = numbers(f"{S}/ev-csv/errors.csv"), numbers(f"{S}/ev-qif/errors.csv")
         check(f"W8: the QIF route gives the CSV route's errors.csv, every printed digit ({len(a) - 1} steps)", a == b and len(a) == 5)
+        ok, e = valid(f"{S}/ev-qif/results.qif")
+        check("W8's results.qif (e_pos, e_proc, e_splz per step with u) validates against the QIF 3.0 XSD", ok, e)
+        code, out, err = run("read", f"{S}/ev-qif/results.qif", "--json")
+        names = {c["name"] for c in json.loads(out)["characteristics"]} if code == 0 else set()
+        check("W8's results.qif names e_pos_x, e_proc_y and e_splz of each step",
+              all(f"{q} step {k}" in names for q in ("e_pos_x", "e_proc_y", "e_splz") for k in range(1, 5)), sorted(names)[:12])
 
 # --- the sphere artifact's probing plan ----------------------------------------------------------
 code, out, err = run("plan", f"{SRC}/parts/sphere_artifact.yaml", "--machine", f"{SRC}/parts/machines/nmv5000.yaml", "--out", f"{W}/sa")
