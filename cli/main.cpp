@@ -21,6 +21,7 @@
 #include "evaluate/point_cloud.hpp"
 #include "evaluate/sphere_campaign.hpp"
 #include "evaluate/test_piece.hpp"
+#include "interop/dmis.hpp"
 #include "interop/qif.hpp"
 #include "interop/summary.hpp"
 #include "model/stepped_prediction.hpp"
@@ -148,9 +149,10 @@ int cmdSimulate(const std::vector<std::string>& program_files, const std::string
   sim::SimulationPart part;
   part.test_piece = &piece;
   if (!cmm_file.empty()) {
-    if (interop::looksLikeQif(readFile(cmm_file))) {  // a QIF plan: the CMM answers in QIF too
-      part.cmm_qif_plan = interop::readQifPlan(cmm_file);
-      part.cmm_points = sim::cmmPointsOfQifPlan(*part.cmm_qif_plan);
+    const std::string text = readFile(cmm_file);
+    if (interop::looksLikeQif(text) || interop::looksLikeDmis(text)) {  // a QIF plan or a DMIS program: answered in both
+      part.cmm_plan = interop::looksLikeQif(text) ? interop::parseQifPlan(text, cmm_file) : interop::parseDmisProgram(text, cmm_file);
+      part.cmm_points = sim::cmmPointsOfQifPlan(*part.cmm_plan);
     } else {
       part.cmm_points = sim::readCmmPoints(cmm_file);
     }
@@ -198,7 +200,8 @@ int cmdSimulate(const std::vector<std::string>& program_files, const std::string
   }
   if (!s.cmm_qif.empty()) {
     writeFileAtomic(join(out_dir, "cmm_results.qif"), s.cmm_qif);
-    extra += ", cmm_results.qif";
+    writeFileAtomic(join(out_dir, "cmm_results.dmo"), s.cmm_dmo);
+    extra += ", cmm_results.qif, cmm_results.dmo";
   }
   const std::string what = program_files.size() == 1 ? program_files.front() : std::to_string(program_files.size()) + " programs";
   std::printf("Simulated %s on %s (seed %llu): %ld blocks, %ld probe events, %.1f h of machine time\n", what.c_str(),
@@ -256,10 +259,17 @@ int cmdEvaluate(const std::string& points_file, const std::string& manifest_file
 
 // Results when the file has any; a plan (its nominal features and planned points) otherwise.
 int cmdRead(const std::string& file, bool json) {
-  auto d = interop::readQifResults(file);
+  const std::string text = readFile(file);
+  if (interop::looksLikeDmis(text)) {  // a program (DMISMN: its nominals and PTMEAS points) or output (FILNAM)
+    const bool program = text.find("MEAS/") != std::string::npos || text.find("meas/") != std::string::npos;
+    const auto d = program ? interop::parseDmisProgram(text, file) : interop::parseDmisOutput(text, file);
+    std::fputs((json ? interop::cmmDocumentJson(d) : interop::cmmDocumentText(d)).c_str(), stdout);
+    return 0;
+  }
+  auto d = interop::parseQifResults(text, file);
   if (d.runs == 0 && d.features.empty()) {
     try {
-      d = interop::readQifPlan(file);
+      d = interop::parseQifPlan(text, file);
     } catch (const InputError&) {  // no feature nominals either: the empty results say so
     }
   }
@@ -362,8 +372,9 @@ int main(int argc, char** argv) {
 
   std::string read_file;
   bool read_json = false;
-  auto* rd = app.add_subcommand("read", "What probeloop reads in a CMM exchange file (QIF 3.0 Results or Plan): features, points, units");
-  rd->add_option("file", read_file, "QIF 3.0 file")->required()->check(CLI::ExistingFile);
+  auto* rd = app.add_subcommand("read", "What probeloop reads in a CMM exchange file (QIF 3.0 Results or Plan, DMIS output or "
+                                "program): features, points, units");
+  rd->add_option("file", read_file, "QIF 3.0 or DMIS file")->required()->check(CLI::ExistingFile);
   rd->add_flag("--json", read_json, "print JSON (every feature with its geometry and points, in mm)");
 
   auto* res = app.add_subcommand("resolution", "Resolution of the location errors (seed 004 Table 5.4)");
@@ -390,7 +401,7 @@ int main(int argc, char** argv) {
   simc->add_option("--out", out, "output folder")->capture_default_str();
   simc->add_option("--seed", seed, "random seed")->capture_default_str();
   simc->add_option("--cmm-points", cmm_points, "machined part: CMM points to measure after the programs "
-                   "(feature,point,x_mm,y_mm,z_mm,nx,ny,nz, or a QIF 3.0 plan: then cmm_results.qif too)")->check(CLI::ExistingFile);
+                   "(feature,point,x_mm,y_mm,z_mm,nx,ny,nz; or a QIF 3.0 plan or a DMIS program: then cmm_results.qif and .dmo too)")->check(CLI::ExistingFile);
   simc->add_flag("--trace", sim_trace, "also write trace.csv: every motion, dwell and tool change with its time and line");
   std::string schedule;
   simc->add_option("--schedule", schedule, "plan manifest (plan.json): start each program at its planned time, the machine "
@@ -398,11 +409,11 @@ int main(int argc, char** argv) {
 
   std::string compare_with;
   auto* ev = app.add_subcommand("evaluate", "Errors of a test piece from probe logs, points CSV, a CMM export or dial-gauge readings");
-  ev->add_option("points", points, "LinuxCNC log, Fanuc DPRNT output, points CSV, CMM export (CSV or QIF 3.0 Results) or gauge CSV")->required()->check(CLI::ExistingFile);
+  ev->add_option("points", points, "LinuxCNC log, Fanuc DPRNT output, points CSV, CMM export (CSV, QIF 3.0 Results or DMIS output) or gauge CSV")->required()->check(CLI::ExistingFile);
   ev->add_option("--manifest", manifest, "plan manifest (plan.json)")->required()->check(CLI::ExistingFile);
   ev->add_option("--out", out, "output folder")->capture_default_str();
-  ev->add_option("--format", format, "auto, linuxcnc, fanuc, csv, cmm, qif or gauge")
-      ->check(CLI::IsMember({"auto", "linuxcnc", "fanuc", "csv", "cmm", "qif", "gauge"}))->capture_default_str();
+  ev->add_option("--format", format, "auto, linuxcnc, fanuc, csv, cmm, qif, dmis or gauge")
+      ->check(CLI::IsMember({"auto", "linuxcnc", "fanuc", "csv", "cmm", "qif", "dmis", "gauge"}))->capture_default_str();
   ev->add_flag("--free-radius", free_radius, "sphere centres from the free-radius fit (default: known radius)");
   ev->add_option("--scene", scene, "also write a glTF scene (the sphere campaign, or the test piece with its deviations)");
   ev->add_option("--exaggeration", exaggeration, "scale of the error vectors in the scene (default: 10000 sphere campaign, 1000 test piece)");

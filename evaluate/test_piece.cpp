@@ -61,7 +61,7 @@ EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateReq
   opt.gauge_resolution_um = r.gauge_resolution_um;
   TtpEvaluation e;
   std::optional<TtpPoints> points;
-  if (fmt == "cmm" || fmt == "qif") {  // a CSV export or QIF 3.0 Results
+  if (fmt == "cmm" || fmt == "qif" || fmt == "dmis") {  // a CSV export, QIF 3.0 Results or DMIS output
     points = readTtpCmmExport(r.input_file, text, m);
     e = evaluateThermalTestPiece(m, *points, opt);
   } else if (fmt == "linuxcnc" || fmt == "fanuc" || fmt == "log" || fmt == "csv") {
@@ -71,7 +71,7 @@ EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateReq
     if (!(r.gauge_resolution_um > 0)) throw InputError("", 0, "the gauge resolution must be positive");
     e = evaluateThermalTestPieceGauge(m, readTtpGauge(r.input_file, text, m), opt);
   } else {
-    throw InputError("", 0, "--format '" + r.format + "': expected auto, cmm, qif, linuxcnc, fanuc, csv or gauge");
+    throw InputError("", 0, "--format '" + r.format + "': expected auto, cmm, qif, dmis, linuxcnc, fanuc, csv or gauge");
   }
   if (!r.compare_with.empty()) e.comparison = compareSpans(e, r.compare_with);
   EvaluationFiles f;
@@ -94,11 +94,11 @@ EvaluationFiles steppedWorkpiece(const parts::PlanManifest& m, const EvaluateReq
                                       "log together: give the log with --probe-log (seed 000 L761: CMM - probe)");
   const std::string text = readFile(r.input_file);
   const std::string fmt = r.format == "auto" ? detectTtpFormat(r.input_file, text) : r.format;
-  if (fmt != "cmm" && fmt != "qif")
-    throw InputError(r.input_file, 0, "expected the CMM export (feature,point,x_mm,y_mm,z_mm,... or QIF 3.0 Results), found a " + fmt + " file");
+  if (fmt != "cmm" && fmt != "qif" && fmt != "dmis")
+    throw InputError(r.input_file, 0, "expected the CMM export (feature,point,x_mm,y_mm,z_mm,..., QIF 3.0 Results or DMIS output), found a " + fmt + " file");
   const std::string log = readFile(r.probe_log);
   const std::string log_fmt = detectTtpFormat(r.probe_log, log);
-  if (log_fmt == "cmm" || log_fmt == "gauge" || log_fmt == "qif")
+  if (log_fmt == "cmm" || log_fmt == "gauge" || log_fmt == "qif" || log_fmt == "dmis")
     throw InputError(r.probe_log, 0, "--probe-log: expected the on-machine probe log (PT lines) or points CSV, found a " + log_fmt + " file");
   EvaluationFiles f;
   const auto cmm = readTtpCmmExport(r.input_file, text, m);

@@ -769,7 +769,7 @@ TEST(TtpOutputs, FormatsAreDetectedFromTheContent) {
   r.input_file = tempFile("gauge.csv", "facet,g_um\nX1_1,1\nX2_1,3\n");
   EXPECT_EQ(evaluateTestPiece(f.m, r).thermal_test_piece->route, TtpRoute::Gauge);
   r.format = "sphere";
-  EXPECT_NE(refusal([&] { evaluateTestPiece(f.m, r); }).find("expected auto, cmm, qif, linuxcnc, fanuc, csv or gauge"), std::string::npos);
+  EXPECT_NE(refusal([&] { evaluateTestPiece(f.m, r); }).find("expected auto, cmm, qif, dmis, linuxcnc, fanuc, csv or gauge"), std::string::npos);
 }
 
 TEST(TtpPrediction, BothRoutesFromThePlannedPointsAlone) {

@@ -10,6 +10,7 @@
 
 #include "core/csv.hpp"
 #include "core/error.hpp"
+#include "interop/dmis.hpp"
 #include "interop/qif.hpp"
 #include "core/units.hpp"
 #include "gcode/probe_log.hpp"
@@ -121,6 +122,7 @@ Vector3d partToMachine(const parts::PlanManifest& m, const Vector3d& p, double c
 
 std::string detectTtpFormat(const std::string& path, const std::string& text) {
   if (interop::looksLikeQif(text)) return "qif";
+  if (interop::looksLikeDmis(text)) return "dmis";
   const std::string first = firstDataLine(text);
   const bool csv = first.find(',') != std::string::npos || first.find(';') != std::string::npos || csvExtension(path);
   if (!csv) return "log";  // a PT log: LinuxCNC LOG and Fanuc DPRNT lines parse alike
@@ -254,10 +256,10 @@ TtpPoints cmmPointsFromRows(const std::string& path, const std::string& format, 
   return out;
 }
 
-// A QIF 3.0 Results document: every measured feature's points, labelled by its name, numbered
-// in their order (the line: the feature measurement's).
-TtpPoints readQifCmmResults(const std::string& path, const std::string& text, const parts::PlanManifest& m) {
-  const auto d = interop::parseQifResults(text, path);
+// A QIF 3.0 Results document or a DMIS output file: every measured feature's points, labelled
+// by its name, numbered in their order (the line: the feature measurement's).
+TtpPoints cmmResults(const std::string& path, const std::string& text, const parts::PlanManifest& m, bool qif) {
+  const auto d = qif ? interop::parseQifResults(text, path) : interop::parseDmisOutput(text, path);
   if (d.runs > 1)
     throw InputError(path, 0, std::to_string(d.runs) + " MeasurementResults (runs) in one file: evaluate reads one part's "
                                                       "measurement; write each run to its own file");
@@ -267,15 +269,17 @@ TtpPoints readQifCmmResults(const std::string& path, const std::string& text, co
     for (const auto& p : f.points) rows.push_back({f.name, ++k, f.line, p.p_mm});
   }
   if (rows.empty())
-    throw InputError(path, 0, "no measured points (MeasuredPointSets) in " + std::to_string(d.features.size()) +
+    throw InputError(path, 0, std::string("no measured points (") + (qif ? "MeasuredPointSets" : "FA(<feature>_Pnn)=FEAT/POINT") + ") in " +
+                                  std::to_string(d.features.size()) +
                                   " measured features: the evaluation fits its own planes and needs the points");
-  return cmmPointsFromRows(path, "qif", rows, true, m);
+  return cmmPointsFromRows(path, qif ? "qif" : "dmis", rows, true, m);
 }
 
 }  // namespace
 
 TtpPoints readTtpCmmExport(const std::string& path, const std::string& text, const parts::PlanManifest& m) {
-  if (interop::looksLikeQif(text)) return readQifCmmResults(path, text, m);
+  if (interop::looksLikeQif(text)) return cmmResults(path, text, m, true);
+  if (interop::looksLikeDmis(text)) return cmmResults(path, text, m, false);
   const CsvTable t = parseCsv(text, path);
   auto col = [&](const char* a, const char* b) {
     const int c = t.column(a);

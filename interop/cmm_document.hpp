@@ -55,11 +55,19 @@ struct CmmCharacteristic {
   double value = 0, u = NAN;
 };
 
+// A program's move (DMIS GOTO, or PTMEAS: the probing move to its point), in order.
+struct CmmMove {
+  int line = 0;
+  Eigen::Vector3d to_mm = Eigen::Vector3d::Zero();
+  bool probing = false;
+};
+
 struct CmmDocument {
   std::string file;       // reading: the path, for messages
   std::string part_name;  // writing: said in the document's header
   std::vector<CmmFeature> features;
   std::vector<CmmCharacteristic> characteristics;
+  std::vector<CmmMove> moves;  // reading a program: its moves (DMIS), for a collision check
   // Reading: the file's own length unit and what was passed over (one line each).
   std::string length_unit = "mm";
   int runs = 0;

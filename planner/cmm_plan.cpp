@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "core/csv.hpp"
+#include "interop/dmis.hpp"
 #include "interop/qif.hpp"
 #include "parts/cmm_feature.hpp"
 
@@ -11,7 +12,9 @@ namespace probeloop::planner {
 
 using Eigen::Vector3d;
 
-std::string qifCmmPlan(const parts::PlanManifest& m, const std::string& cmm_points_csv) {
+namespace {
+
+interop::CmmDocument cmmPlanDocument(const parts::PlanManifest& m, const std::string& cmm_points_csv) {
   const CsvTable t = parseCsv(cmm_points_csv, "cmm_points.csv");
   const int cf = t.column("feature"), cx = t.column("x_mm"), cy = t.column("y_mm"), cz = t.column("z_mm"), nx = t.column("nx"),
             ny = t.column("ny"), nz = t.column("nz");
@@ -33,7 +36,17 @@ std::string qifCmmPlan(const parts::PlanManifest& m, const std::string& cmm_poin
     d.features[it->second].points.push_back(p);
   }
   for (auto& f : d.features) parts::setInternalFromPoints(f);
-  return interop::qifPlan(d);
+  return d;
+}
+
+}  // namespace
+
+std::string qifCmmPlan(const parts::PlanManifest& m, const std::string& cmm_points_csv) {
+  return interop::qifPlan(cmmPlanDocument(m, cmm_points_csv));
+}
+
+std::string dmisCmmPlan(const parts::PlanManifest& m, const std::string& cmm_points_csv) {
+  return interop::dmisProgram(cmmPlanDocument(m, cmm_points_csv), m.part_name.substr(0, 60));
 }
 
 std::string qifSphereProbePlan(const parts::PlanManifest& m) {

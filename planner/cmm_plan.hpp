@@ -1,4 +1,4 @@
-// The CMM point plan as a QIF 3.0 Plan (interop/qif.hpp): each measured feature of the
+// The CMM point plan as a QIF 3.0 Plan (interop/qif.hpp) and as a DMIS program (interop/dmis.hpp): each measured feature of the
 // manifest with its nominal geometry (part frame) and its planned points (surface point and
 // outward normal), for CMM software that reads QIF instead of our cmm_points.csv. The sphere
 // artifact's on-machine probing plan the same way: each C position's sphere (machine frame at
@@ -16,9 +16,12 @@
 namespace probeloop::planner {
 
 inline constexpr const char* kQifCmmPlanFile = "cmm_plan.qif";
+inline constexpr const char* kDmisCmmPlanFile = "cmm_plan.dmi";
 inline constexpr const char* kQifProbePlanFile = "probe_plan.qif";
 
 std::string qifCmmPlan(const parts::PlanManifest& m, const std::string& cmm_points_csv);
+// The same plan as a DMIS program (interop/dmis.hpp: the moves vertical or at a clearance height).
+std::string dmisCmmPlan(const parts::PlanManifest& m, const std::string& cmm_points_csv);
 std::string qifSphereProbePlan(const parts::PlanManifest& m);
 
 }  // namespace probeloop::planner

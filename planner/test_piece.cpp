@@ -113,6 +113,7 @@ TestPiecePlan thermal(const parts::TestPiece& piece, const parts::ThermalTestPie
   const auto& man = plan.manifest;
   out.files.emplace_back(man.ttp.cmm_plan, plan.cmm_points_csv);
   out.files.emplace_back(kQifCmmPlanFile, qifCmmPlan(man, plan.cmm_points_csv));
+  out.files.emplace_back(kDmisCmmPlanFile, dmisCmmPlan(man, plan.cmm_points_csv));
 
   std::ostringstream s;
   s << "Planned the thermal test piece (seed 004 Ch. 7) for " << m.name << " (" << parts::dialectName(dialect)
@@ -161,10 +162,12 @@ TestPiecePlan thermal(const parts::TestPiece& piece, const parts::ThermalTestPie
   s << "Inspection: " << man.points.size() << " points (TOP " << per["TOP"] << ", FLANK_P " << per["FLANK_P"] << ", FLANK_N "
     << per["FLANK_N"] << ", CYL " << per["CYL"] << ", " << t.z_paths << " Z paths x " << per[parts::zPathId(1)] << ", "
     << 4 * t.facets_per_segment << " facets x " << per[parts::facetId(parts::FacetSide::X1, 1)]
-    << "); the CMM measures the same points (" << man.ttp.cmm_plan << ", as QIF 3.0 " << kQifCmmPlanFile << ")\n";
+    << "); the CMM measures the same points (" << man.ttp.cmm_plan << ", as QIF 3.0 " << kQifCmmPlanFile << ", as DMIS "
+    << kDmisCmmPlanFile << ")\n";
   s << "  wrote";
   for (const auto& p : out.programs) s << " " << join(out_dir, p.file) << ",";
-  s << " " << join(out_dir, man.ttp.cmm_plan) << ", " << join(out_dir, kQifCmmPlanFile) << " and " << join(out_dir, "plan.json") << "\n";
+  s << " " << join(out_dir, man.ttp.cmm_plan) << ", " << join(out_dir, kQifCmmPlanFile) << ", " << join(out_dir, kDmisCmmPlanFile) << " and "
+    << join(out_dir, "plan.json") << "\n";
   s << "  (planned with the simulator's clock, no acceleration: docs/simulator.md §2, docs/thermal-test-piece.md §5)\n";
   out.summary = s.str();
   out.manifest = std::move(plan.manifest);
@@ -191,6 +194,7 @@ TestPiecePlan stepped(const parts::SteppedWorkpiece& w, const std::string& exper
   const auto& man = plan.manifest;
   out.files.emplace_back(man.sw.cmm_plan, plan.cmm_points_csv);
   out.files.emplace_back(kQifCmmPlanFile, qifCmmPlan(man, plan.cmm_points_csv));
+  out.files.emplace_back(kDmisCmmPlanFile, dmisCmmPlan(man, plan.cmm_points_csv));
   const auto* e = w.experiment(experiment);
   std::ostringstream s;
   std::string sizes;
@@ -224,7 +228,8 @@ TestPiecePlan stepped(const parts::SteppedWorkpiece& w, const std::string& exper
       << " rpm, cut " << hms(st.start_s) << " - " << hms(st.end_s) << ", T = " << formatNumber(st.temp_state_min, 2) << " min\n";
   s << "  wrote";
   for (const auto& p : out.programs) s << " " << join(out_dir, p.file) << ",";
-  s << " " << join(out_dir, man.sw.cmm_plan) << ", " << join(out_dir, kQifCmmPlanFile) << " and " << join(out_dir, "plan.json") << "\n";
+  s << " " << join(out_dir, man.sw.cmm_plan) << ", " << join(out_dir, kQifCmmPlanFile) << ", " << join(out_dir, kDmisCmmPlanFile) << " and "
+    << join(out_dir, "plan.json") << "\n";
   s << "  (planned with the simulator's clock, no acceleration: docs/simulator.md §2, docs/stepped-workpiece.md §4)\n";
   out.summary = s.str();
   out.manifest = std::move(plan.manifest);

@@ -80,9 +80,10 @@ TEST(PlanTestPiece, TheSteppedWorkpieceIsPlannedPerExperiment) {
   ASSERT_EQ(plan.programs.size(), 3u);
   EXPECT_EQ(plan.programs[0].file, "roughing.nc");
   EXPECT_EQ(plan.programs[2].file, "probing.nc");
-  ASSERT_EQ(plan.files.size(), 2u);
+  ASSERT_EQ(plan.files.size(), 3u);
   EXPECT_EQ(plan.files[0].first, "cmm_points.csv");
   EXPECT_EQ(plan.files[1].first, "cmm_plan.qif");
+  EXPECT_EQ(plan.files[2].first, "cmm_plan.dmi");
   EXPECT_EQ(plan.manifest.kind, "stepped_workpiece");
   for (const char* s : {"Planned experiment W8", "O3002", "step 4: feed XY 800 / Z 800 mm/min, 3500 rpm", "T = "})
     EXPECT_NE(plan.summary.find(s), std::string::npos) << s << "\n" << plan.summary;
@@ -113,7 +114,9 @@ TEST(PlanTestPiece, TheThermalTestPieceGivesThreeProgramsTheCmmPlanAndASummary) 
   }
   EXPECT_EQ(plan.manifest.programs[2].log_file, "ttp_probe.log");
   EXPECT_EQ(plan.manifest.programs[0].log_file, "");
-  ASSERT_EQ(plan.files.size(), 2u);
+  ASSERT_EQ(plan.files.size(), 3u);
+  EXPECT_EQ(plan.files[2].first, "cmm_plan.dmi");
+  EXPECT_NE(plan.files[2].second.find("\nF(CYL)=FEAT/CYLNDR,OUTER,CART,"), std::string::npos);
   EXPECT_EQ(plan.files[0].first, "cmm_points.csv");
   EXPECT_NE(plan.files[0].second.find("feature,point,x_mm,y_mm,z_mm,nx,ny,nz\nTOP,1,"), std::string::npos);
   EXPECT_EQ(plan.files[1].first, "cmm_plan.qif");
@@ -123,7 +126,7 @@ TEST(PlanTestPiece, TheThermalTestPieceGivesThreeProgramsTheCmmPlanAndASummary) 
   EXPECT_EQ(plan.files[1].second.find("INTERNAL"), std::string::npos);
   EXPECT_NE(plan.files[1].second.find("<FeatureName>X2_9</FeatureName>"), std::string::npos);
   for (const char* s : {"45 measurement surfaces: 9 Z paths (12 mm pitch) + 36 facets (4 x 9, 6 deg pitch)",
-                        "8 waits of 3600 s + 9 cutting cycles", "Inspection: 364 points", "plan/cmm_points.csv, plan/cmm_plan.qif and plan/plan.json",
+                        "8 waits of 3600 s + 9 cutting cycles", "Inspection: 364 points", "plan/cmm_points.csv, plan/cmm_plan.qif, plan/cmm_plan.dmi and plan/plan.json",
                         "C at 1200 rpm (180 x 200 turns forward and back)"})
     EXPECT_NE(plan.summary.find(s), std::string::npos) << s << "\n" << plan.summary;
   // The LinuxCNC dialect of the same machine: .ngc files, the inspection log opened by name.

@@ -8,7 +8,6 @@
 #include "core/csv.hpp"
 #include "core/error.hpp"
 #include "interop/measured_geometry.hpp"
-#include "interop/qif.hpp"
 #include "sim/material_removal.hpp"
 #include "sim/random_streams.hpp"
 
@@ -61,14 +60,37 @@ std::vector<CmmPoint> cmmPointsOfQifPlan(const interop::CmmDocument& plan) {
   return out;
 }
 
-std::string cmmResultsQif(const interop::CmmDocument& plan, const std::vector<Eigen::Vector3d>& measured_mm) {
+void checkCmmMoves(const Stock& stock, const interop::CmmDocument& plan) {
+  if (plan.moves.empty()) return;
+  // A probing move returns to where it started (the CMM backs off after the touch).
+  Eigen::Vector3d a = plan.moves.front().to_mm;
+  for (std::size_t i = 1; i < plan.moves.size(); ++i) {
+    const auto& m = plan.moves[i];
+    const Eigen::Vector3d from = a;
+    if (!m.probing) a = m.to_mm;
+    const Eigen::Vector3d d = m.to_mm - from;
+    const double len = d.norm();
+    if (len < 1e-9) continue;
+    const auto hit = stock.firstMaterial(from, d / len, len);
+    const double allowed = m.probing ? len - 0.5 : len;  // a probing move ends on the surface
+    if (hit && *hit < allowed) {
+      const Eigen::Vector3d at = from + *hit * d / len;
+      throw InputError(plan.file, m.line, std::string(m.probing ? "PTMEAS" : "GOTO") + " to " + formatNumber(m.to_mm.x(), 3) + "," +
+                                              formatNumber(m.to_mm.y(), 3) + "," + formatNumber(m.to_mm.z(), 3) +
+                                              ": the move enters the part at " + formatNumber(at.x(), 3) + "," + formatNumber(at.y(), 3) +
+                                              "," + formatNumber(at.z(), 3) + " (" + formatNumber(*hit, 3) + " mm along it)");
+    }
+  }
+}
+
+interop::CmmDocument cmmResultsDocument(const interop::CmmDocument& plan, const std::vector<Eigen::Vector3d>& measured_mm) {
   interop::CmmDocument r = plan;
   std::size_t i = 0;
   for (auto& f : r.features) {
     for (auto& p : f.points) p.p_mm = measured_mm.at(i++);
     interop::fitMeasuredGeometry(f);
   }
-  return interop::qifResults(r);
+  return r;
 }
 
 std::string measureOnCmm(const Stock& stock, const parts::Workpiece& w, const std::vector<CmmPoint>& points,

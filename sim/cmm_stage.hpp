@@ -39,7 +39,7 @@ std::vector<CmmPoint> readCmmPoints(const std::string& path);
 // A QIF 3.0 plan (interop/qif.hpp readQifPlan) as the CMM's points: each feature's planned
 // points in order, numbered from 1, line = the feature nominal's line; a point without its
 // Normal is refused (the CMM approaches along it).
-std::vector<CmmPoint> cmmPointsOfQifPlan(const interop::CmmDocument& plan);
+std::vector<CmmPoint> cmmPointsOfQifPlan(const interop::CmmDocument& plan);  // a DMIS program's too
 
 // alpha_per_K: the part's real expansion coefficient (NaN: the workpiece material's).
 std::string measureOnCmm(const Stock& stock, const parts::Workpiece& w, const std::vector<CmmPoint>& points,
@@ -47,12 +47,21 @@ std::string measureOnCmm(const Stock& stock, const parts::Workpiece& w, const st
                          double alpha_per_K = std::numeric_limits<double>::quiet_NaN(), double search_mm = 5.0,
                          std::vector<Eigen::Vector3d>* measured_mm = nullptr);
 
-// The CMM's QIF 3.0 Results for a QIF plan: the plan's features (nominals kept) with their
+// The CMM's results for a QIF plan or a DMIS program: the plan's features (nominals kept) with their
 // measured points (in the plan's order, the plan's outward normals) and the least-squares
 // geometry of each (plane, sphere, cylinder; its form = the fit's range of residuals), as
 // CMM software reports them; a cylinder probed in one section gets its circle's (centre on the
 // axis, the circle's normal as the axis). A feature whose points fix no element keeps its
 // points without geometry.
-std::string cmmResultsQif(const interop::CmmDocument& plan, const std::vector<Eigen::Vector3d>& measured_mm);
+// A program's moves (a DMIS program's GOTO and PTMEAS, plan.moves) against the part as cut,
+// the stylus tip as a point (its shaft and the probe body are not modelled): a move that enters
+// material, or a probing move that meets it more than 0.5 mm before its point, is an InputError
+// naming the program's line, before anything is measured; after a probing move the tip is back
+// where that move started. No moves (a QIF plan, a CSV): nothing
+// to check; the first move is where the CMM starts.
+void checkCmmMoves(const Stock& stock, const interop::CmmDocument& plan);
+
+// cmmResultsDocument: the same as a document, for the QIF and the DMIS writers.
+interop::CmmDocument cmmResultsDocument(const interop::CmmDocument& plan, const std::vector<Eigen::Vector3d>& measured_mm);
 
 }  // namespace probeloop::sim

@@ -15,6 +15,8 @@
 #include "core/error.hpp"
 #include "core/units.hpp"
 #include "gcode/probe_log.hpp"
+#include "interop/dmis.hpp"
+#include "interop/qif.hpp"
 #include "model/effects.hpp"
 #include "sim/material_removal.hpp"
 #include "sim/random_streams.hpp"
@@ -1382,9 +1384,14 @@ SimulationOutputs simulatePrograms(const std::vector<ProgramSource>& programs, c
     out.cuts_json = vm.cutsJson();
     if (!part.cmm_points.empty()) {
       std::vector<Eigen::Vector3d> measured;
+      if (part.cmm_plan) checkCmmMoves(vm.stock(), *part.cmm_plan);
       out.cmm_csv = measureOnCmm(vm.stock(), *part.workpiece, part.cmm_points, part.cmm_points_file, seed, vm.partAlphaPerK(), 5.0,
                                  &measured);
-      if (part.cmm_qif_plan) out.cmm_qif = cmmResultsQif(*part.cmm_qif_plan, measured);
+      if (part.cmm_plan) {
+        const auto results = cmmResultsDocument(*part.cmm_plan, measured);
+        out.cmm_qif = interop::qifResults(results);
+        out.cmm_dmo = interop::dmisOutput(results, "PROBELOOP SIMULATED CMM");
+      }
     }
   }
 

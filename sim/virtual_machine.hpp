@@ -64,7 +64,8 @@ struct SimulationOutputs {
   std::string truth_json;  // injected error values per probe event and per cycle; a thermal test piece's as-cut truth
   std::string cuts_json;   // workpiece: the surfaces actually cut (swept volumes), forces
   std::string cmm_csv;     // workpiece with CMM points: the CMM export
-  std::string cmm_qif;     // ... planned in QIF: the CMM's QIF 3.0 Results
+  std::string cmm_qif;     // ... planned in QIF or DMIS: the CMM's QIF 3.0 Results
+  std::string cmm_dmo;     // ... and its DMIS output
   std::string trace_csv;   // with SimulationPart::trace: every motion, dwell and tool change
   double end_time_s = 0;
   long probe_events = 0;
@@ -82,7 +83,7 @@ struct SimulationPart {
   const parts::TestPiece* test_piece = nullptr;
   std::vector<CmmPoint> cmm_points;  // workpiece: measured on the CMM after the program
   std::string cmm_points_file = "CMM points";  // for error messages
-  std::optional<interop::CmmDocument> cmm_qif_plan;  // the points came as a QIF plan: answer in QIF too
+  std::optional<interop::CmmDocument> cmm_plan;  // the points came as a QIF plan or a DMIS program: answer in both
   bool trace = false;                // also write the motion trace
 };
 

@@ -64,9 +64,9 @@ code, out, err = run("plan", PIECE, "--machine", VMC, "--out", f"{W}/bad_comp", 
 check("a compensation for W5 is refused when W8 is planned", code != 0 and "experiment: 'W5', but W8 is planned" in err
       and not os.path.exists(f"{W}/bad_comp"), err)
 for name, ext in (("w8_lc", "ngc"), ("w8_fa", "nc")):
-    want = sorted([f"roughing.{ext}", f"finishing.{ext}", f"probing.{ext}", "cmm_points.csv", "cmm_plan.qif", "plan.json"])
+    want = sorted([f"roughing.{ext}", f"finishing.{ext}", f"probing.{ext}", "cmm_points.csv", "cmm_plan.qif", "cmm_plan.dmi", "plan.json"])
     got = sorted(os.listdir(dirs[name])) if os.path.isdir(dirs[name]) else []
-    check(f"{name}: writes the three .{ext} programs, cmm_points.csv, cmm_plan.qif and plan.json", got == want, got)
+    check(f"{name}: writes the three .{ext} programs, cmm_points.csv, cmm_plan.qif, cmm_plan.dmi and plan.json", got == want, got)
 fa_text = open(f"{dirs['w8_fa']}/roughing.nc").read() if os.path.exists(f"{dirs['w8_fa']}/roughing.nc") else ""
 check("Fanuc programs are numbered O3001..O3003", all(
     re.search(rf"^O{n}\b", open(f"{dirs['w8_fa']}/{f}.nc").read(), re.M)

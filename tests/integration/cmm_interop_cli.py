@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""QIF 3.0 through the real CLI (issue 15 items 1-2):
+"""QIF 3.0 and DMIS through the real CLI (issue 15 items 1-3):
 
 - every QIF file probeloop writes validates with xmllint against the QIF 3.0.0 XSD of
   ../shared/refdata/qif3: the CMM plans of the thermal test piece and of the stepped workpiece,
@@ -10,8 +10,12 @@
   carries its errors with their u as characteristics and its measured features;
 - other software's samples (refdata/qif3/samples) read with the counts and coordinates that
   `xmllint --xpath` gives for them, computed here, independently of probeloop;
-- bad input: a QIF file of another version, and a point set whose count does not match its
-  points, are refused naming the file, the line and the field, and nothing is written.
+- DMIS: the plans' cmm_plan.dmi (every PTMEAS of cmm_points.csv, lines within 80 characters)
+  drives the simulated CMM, which checks every move against the part as cut and answers with
+  cmm_results.dmo; evaluate on it gives the CSV route's errors.csv, every printed digit;
+- bad input: a QIF file of another version, a point set whose count does not match its points,
+  a DMIS output with a feature we did not plan, and a DMIS program whose move goes through the
+  part are refused naming the file, the line and the field, and nothing is written.
 
 Needs $PROBELOOP, $PROBELOOP_SOURCE_DIR and xmllint (libxml2-utils)."""
 import json, os, re, subprocess, sys, tempfile
@@ -110,6 +114,42 @@ if code == 0:
         check(f"results.qif carries the {len(r['features'])} measured features with their points and fitted geometry",
               len(r["features"]) == 49 and sum(len(f["points_mm"]) for f in r["features"]) == csv_points
               and all("measured" in f for f in r["features"]), err)
+    # DMIS: the program drives the simulated CMM; its output evaluates like the CSV.
+    dmi = open(f"{T}/plan/cmm_plan.dmi").read()
+    lines = dmi.splitlines()
+    ptmeas = sum(1 for l in lines if l.startswith("PTMEAS/"))
+    check(f"cmm_plan.dmi: a PTMEAS per planned point ({ptmeas}), every line within 80 characters, DMISMN ... ENDFIL",
+          ptmeas == csv_points and max(len(l) for l in lines) <= 80 and lines[0].startswith("DMISMN/") and lines[-1] == "ENDFIL")
+    code, out, err = run("simulate", "pre_machining.nc", "thermal_test.nc", "inspection.nc", "--machine", f"{SRC}/parts/machines/nmv5000.yaml",
+                         "--part", piece, "--truth", f"{SRC}/examples/truth_thermal_test.yaml", "--cmm-points", "cmm_plan.dmi",
+                         "--out", f"{T}/run-dmis", cwd=f"{T}/plan")
+    check("simulate with the CMM running cmm_plan.dmi (its moves checked against the part): cmm_results.dmo",
+          code == 0 and "cmm_results.dmo" in out, err)
+    if code == 0:
+        c3, out3, e3 = run("evaluate", f"{T}/run-dmis/cmm_results.dmo", "--manifest", f"{T}/plan/plan.json", "--out", f"{T}/ev-dmis")
+        check("evaluate the DMIS output", c3 == 0 and "assigned by labels" in out3, e3)
+        if c3 == 0 and c1 == 0:
+            a, b = numbers(f"{T}/ev-csv/errors.csv"), numbers(f"{T}/ev-dmis/errors.csv")
+            check(f"the DMIS route gives the CSV route's errors.csv, every printed digit ({len(a) - 1} cycles)", a == b and len(a) > 2,
+                  next((f"{x.strip()} | {y.strip()}" for x, y in zip(a, b) if x != y), "row count"))
+        # A feature we did not plan, reported beside ours.
+        dmo = open(f"{T}/run-dmis/cmm_results.dmo").read().replace("ENDFIL", "FA(EXTRA_P01)=FEAT/POINT,CART,1,2,3,0,0,1\nFA(EXTRA)=FEAT/PLANE,CART,1,2,3,0,0,1\nENDFIL")
+        open(f"{W}/extra.dmo", "w").write(dmo)
+        line = dmo[: dmo.index("FA(EXTRA_P01)")].count("\n") + 1
+        code, _, err = run("evaluate", f"{W}/extra.dmo", "--manifest", f"{T}/plan/plan.json", "--out", f"{W}/bad-extra")
+        check(f"a DMIS output with a feature we did not plan is refused at its line {line}, naming it",
+              code != 0 and f"extra.dmo:{line}: feature 'EXTRA' is not a feature of the manifest" in err and not os.path.exists(f"{W}/bad-extra"), err)
+    # A program whose move goes through the part: the CMM refuses it before measuring.
+    # (straight down from the first clearance position, above a TOP point, to 5 mm below the top)
+    first_clear = next(i for i, l in enumerate(lines) if l.startswith("GOTO/"))
+    x, y, _ = lines[first_clear][5:].split(",")
+    crash = lines[: first_clear + 1] + [f"GOTO/{x},{y},-5"] + lines[first_clear + 1:]
+    open(f"{T}/plan/crash.dmi", "w").write("\n".join(crash) + "\n")
+    code, _, err = run("simulate", "pre_machining.nc", "thermal_test.nc", "inspection.nc", "--machine", f"{SRC}/parts/machines/nmv5000.yaml",
+                       "--part", piece, "--truth", f"{SRC}/examples/truth_thermal_test.yaml", "--cmm-points", "crash.dmi",
+                       "--out", f"{W}/bad-crash", cwd=f"{T}/plan")
+    check(f"a DMIS program that moves through the part is refused at its line {first_clear + 2}, nothing written",
+          code != 0 and f"crash.dmi:{first_clear + 2}: GOTO to " in err and "the move enters the part at" in err and not os.path.exists(f"{W}/bad-crash"), err)
     code, out, err = run("read", f"{T}/run/cmm_results.qif", "--json")
     d = json.loads(out) if code == 0 else {}
     cyl = [f for f in d.get("features", []) if f["name"] == "CYL"]
@@ -152,6 +192,12 @@ if code == 0:
     if c1 == 0 and c2 == 0:
         a, b = numbers(f"{S}/ev-csv/errors.csv"), numbers(f"{S}/ev-qif/errors.csv")
         check(f"W8: the QIF route gives the CSV route's errors.csv, every printed digit ({len(a) - 1} steps)", a == b and len(a) == 5)
+        code, out, err = run("simulate", "roughing.ngc", "finishing.ngc", "probing.ngc", "--machine", f"{SRC}/parts/machines/vmc3.yaml",
+                             "--part", f"{SRC}/parts/stepped_workpiece.yaml", "--truth", f"{SRC}/examples/stepped_workpiece/truth.yaml",
+                             "--cmm-points", "cmm_plan.dmi", "--schedule", "plan.json", "--out", f"{S}/run-dmis", cwd=f"{S}/plan")
+        c3, _, e3 = run("evaluate", f"{S}/run-dmis/cmm_results.dmo", *args, "--out", f"{S}/ev-dmis") if code == 0 else (1, "", err)
+        check("W8: the CMM runs cmm_plan.dmi (moves checked) and its DMIS output gives the CSV route's errors.csv",
+              c3 == 0 and numbers(f"{S}/ev-dmis/errors.csv") == a, e3)
         ok, e = valid(f"{S}/ev-qif/results.qif")
         check("W8's results.qif (e_pos, e_proc, e_splz per step with u) validates against the QIF 3.0 XSD", ok, e)
         code, out, err = run("read", f"{S}/ev-qif/results.qif", "--json")

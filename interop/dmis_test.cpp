@@ -1,0 +1,184 @@
+// DMIS programs and output (interop/dmis.hpp): what we write reads back to the same features
+// and points, keeps its lines within 80 characters and its moves vertical or at the clearance
+// height; output as other packages write it (GEOPAK's direction angles, the DMSC demo, a Trimek
+// sphere without INNER/OUTER, lower case, continuations, CRLF, inches) reads; bad files are
+// refused with file:line.
+#include "interop/dmis.hpp"
+
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+#include "core/error.hpp"
+
+namespace probeloop::interop {
+namespace {
+
+CmmDocument plan() {
+  CmmDocument d;
+  d.part_name = "test";
+  CmmFeature p;
+  p.name = "X1_3";
+  p.kind = CmmFeatureKind::Plane;
+  p.nominal = {true, {50, 25, 10}, {0, 0, 1}, NAN, NAN};
+  for (double x : {40.0, 60.0})
+    for (double y : {15.0, 35.0}) p.points.push_back({{x, y, 10}, {0, 0, 1}});
+  d.features.push_back(p);
+  CmmFeature c;
+  c.name = "BORE1";
+  c.kind = CmmFeatureKind::Cylinder;
+  c.internal = true;
+  c.nominal = {true, {100, 50, -10}, {0, 0, 1}, 20, NAN};
+  for (int k = 0; k < 6; ++k) {
+    const double a = k * M_PI / 3;
+    const Eigen::Vector3d r(std::cos(a), std::sin(a), 0);
+    c.points.push_back({Eigen::Vector3d(100, 50, k % 2 ? -5 : -15) + 10 * r, -r});
+  }
+  d.features.push_back(c);
+  CmmFeature s;
+  s.name = "SPH1";
+  s.kind = CmmFeatureKind::Sphere;
+  s.nominal = {true, {150, 50, 12.5}, {0, 0, 0}, 25, NAN};
+  for (const Eigen::Vector3d& n : {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(1, 0, 1).normalized(), Eigen::Vector3d(0, 1, 1).normalized(),
+                                   Eigen::Vector3d(-1, 0, 1).normalized(), Eigen::Vector3d(0, -1, 1).normalized()})
+    s.points.push_back({s.nominal.location_mm + 12.5 * n, n});
+  d.features.push_back(s);
+  return d;
+}
+
+TEST(Dmis, AProgramReadsBackToItsFeaturesAndPoints) {
+  const auto a = plan();
+  const std::string text = dmisProgram(a, "TEST PLAN");
+  const auto b = parseDmisProgram(text, "plan.dmi");
+  ASSERT_EQ(b.features.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const auto& x = a.features[i];
+    const auto& y = b.features[i];
+    EXPECT_EQ(y.name, x.name);
+    EXPECT_EQ(y.kind, x.kind);
+    EXPECT_EQ(y.internal, x.internal);
+    EXPECT_LT((y.nominal.location_mm - x.nominal.location_mm).norm(), 1e-6);
+    ASSERT_EQ(y.points.size(), x.points.size());
+    for (std::size_t k = 0; k < x.points.size(); ++k) {
+      EXPECT_LT((y.points[k].p_mm - x.points[k].p_mm).norm(), 1e-6);
+      EXPECT_LT((y.points[k].normal - x.points[k].normal).norm(), 1e-6);  // written to 6 decimals
+    }
+  }
+  EXPECT_NEAR(b.features[1].nominal.diameter_mm, 20, 1e-9);
+  EXPECT_NEAR(b.features[2].nominal.diameter_mm, 25, 1e-9);
+  EXPECT_EQ(text.rfind("DMISMN/'TEST PLAN',05.2\n", 0), 0u);
+  EXPECT_NE(text.find("\nMEAS/CYLNDR,F(BORE1),6\n"), std::string::npos);
+  EXPECT_NE(text.find("\nENDFIL\n"), std::string::npos);
+  EXPECT_EQ(text, dmisProgram(a, "TEST PLAN"));
+}
+
+// Every physical line within 80 characters; every move vertical or at the clearance height
+// (above every point), so that no move crosses the part between two probed points.
+TEST(Dmis, TheProgramsMovesAreVerticalOrAtTheClearanceHeight) {
+  const std::string text = dmisProgram(plan(), "TEST PLAN");
+  std::istringstream in(text);
+  std::string joined, line;
+  std::vector<Eigen::Vector3d> moves;
+  while (std::getline(in, line)) {
+    EXPECT_LE(line.size(), 80u) << line;
+    if (!line.empty() && line.back() == '$') {
+      joined += line.substr(0, line.size() - 1);
+      continue;
+    }
+    joined += line;
+    if (joined.rfind("GOTO/", 0) == 0) {
+      double x, y, z;
+      ASSERT_EQ(std::sscanf(joined.c_str(), "GOTO/%lf,%lf,%lf", &x, &y, &z), 3) << joined;
+      moves.emplace_back(x, y, z);
+    }
+    joined.clear();
+  }
+  ASSERT_EQ(moves.size(), 3u * 15);  // up, down, (PTMEAS), up per point
+  double clear = -1e9;
+  for (const auto& m : moves) clear = std::max(clear, m.z());
+  EXPECT_NEAR(clear, 25 + 5 + 20, 1e-9);  // the sphere's top point + 5 mm approach + 20 mm
+  for (std::size_t i = 1; i < moves.size(); ++i) {
+    const bool vertical = (moves[i].head<2>() - moves[i - 1].head<2>()).norm() < 1e-9;
+    const bool at_clearance = moves[i].z() == clear && moves[i - 1].z() == clear;
+    EXPECT_TRUE(vertical || at_clearance) << i << ": " << moves[i - 1].transpose() << " -> " << moves[i].transpose();
+  }
+}
+
+TEST(Dmis, OutputReadsBackToMeasuredFeaturesWithTheirPoints) {
+  auto r = plan();
+  for (auto& f : r.features) {
+    f.measured = f.nominal;
+    f.measured.location_mm += Eigen::Vector3d(0.001, -0.002, 0.0005);
+    for (auto& p : f.points) p.p_mm += 0.0013 * p.normal;
+  }
+  r.features[2].measured.given = false;  // a feature without a fit: points only
+  const auto d = parseDmisOutput(dmisOutput(r, "RUN"), "run.dmo");
+  ASSERT_EQ(d.features.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(d.features[i].name, r.features[i].name);
+    EXPECT_EQ(d.features[i].kind, r.features[i].kind);
+    EXPECT_EQ(d.features[i].measured.given, i < 2);
+    ASSERT_EQ(d.features[i].points.size(), r.features[i].points.size());
+    for (std::size_t k = 0; k < r.features[i].points.size(); ++k)
+      EXPECT_LT((d.features[i].points[k].p_mm - r.features[i].points[k].p_mm).norm(), 1e-6);
+  }
+  EXPECT_LT((d.features[0].measured.location_mm - r.features[0].measured.location_mm).norm(), 1e-6);
+  EXPECT_TRUE(d.features[1].internal);
+  EXPECT_GT(d.features[0].line, 0);
+}
+
+// As other packages write it: GEOPAK (direction angles in degrees, continued lines, a point
+// without a vector), the DMSC demo (FILNAM, tolerances, datums), a Trimek sphere without
+// INNER/OUTER; in lower case with CRLF and in inches.
+TEST(Dmis, OtherPackagesOutputReads) {
+  const std::string geopak =
+      "$$ Data from GEOPAK Copyright (c) 2004 Mitutoyo Messgeraete GmbH\r\n"
+      "FA(FeatureID_1) = FEAT/PLANE, CART,$\r\n"
+      "0.000037832313, -0.392125000586, -2.140539040020,$\r\n"
+      "179.991497992475, 90.008501976792, 90.000022920378\r\n"
+      "FA(FeatureID_3) = FEAT/POINT, CART, 3.349968393187, -1.313496902315, -1.431274697897, 0, 0, 0\r\n";
+  const auto g = parseDmisOutput(geopak, "geopak.dmo");
+  ASSERT_EQ(g.features.size(), 2u);
+  EXPECT_EQ(g.features[0].name, "FEATUREID_1");
+  EXPECT_EQ(g.features[0].kind, CmmFeatureKind::Plane);
+  EXPECT_EQ(g.features[0].line, 2);
+  EXPECT_LT((g.features[0].measured.direction - Eigen::Vector3d(-1, 0, 0)).norm(), 1e-3);
+  EXPECT_NEAR(g.features[0].measured.location_mm.z(), -2.140539040020, 1e-12);
+  EXPECT_EQ(g.features[1].kind, CmmFeatureKind::Point);
+  ASSERT_EQ(g.features[1].points.size(), 1u);
+  const std::string dmsc =
+      "FILNAM/'cpp.qif',5.3\nUNITS/MM,ANGDEC\nOUTPUT/FA(DAT_A),TA(FLAT1)\nFA(DAT_A)=FEAT/PLANE,CART,0,0,0,0,0,1\n"
+      "TA(FLAT1)=TOL/FLAT,0.023,INTOL\nDATDEF/FA(DAT_A),DAT(A)\nfa(esfera_10)=feat/sphere,cart,74.8580,58.0652,3.7478,27.8511\nENDFIL\n";
+  const auto m = parseDmisOutput(dmsc, "dmsc.dmo");
+  ASSERT_EQ(m.features.size(), 2u);
+  EXPECT_EQ(m.features[1].name, "ESFERA_10");
+  EXPECT_NEAR(m.features[1].measured.diameter_mm, 27.8511, 1e-12);
+  ASSERT_EQ(m.notes.size(), 3u) << m.notes.front();  // DATDEF, OUTPUT, TA()=TOL: passed over, counted
+  const auto inch = parseDmisOutput("FILNAM/'x'\nUNITS/INCH,ANGDEC\nFA(P)=FEAT/POINT,CART,1,2,3,0,0,1\n", "inch.dmo");
+  ASSERT_EQ(inch.features.size(), 1u);
+  EXPECT_LT((inch.features[0].measured.location_mm - Eigen::Vector3d(25.4, 50.8, 76.2)).norm(), 1e-12);
+  EXPECT_EQ(inch.length_unit, "inch");
+}
+
+void expectRefused(const std::string& text, const std::string& want, bool program = true) {
+  try {
+    program ? parseDmisProgram(text, "bad.dmi") : parseDmisOutput(text, "bad.dmo");
+    ADD_FAILURE() << "accepted; expected '" << want << "'";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
+  }
+}
+
+TEST(Dmis, RefusesWhatDoesNotAddUp) {
+  const std::string f = "DMISMN/'x',05.2\nF(A)=FEAT/PLANE,CART,0,0,0,0,0,1\n";
+  expectRefused(f + "MEAS/PLANE,F(A),3\nPTMEAS/CART,0,0,0,0,0,1\nENDMES\n", "bad.dmi:3: MEAS/..,F(A),3: 1 PTMEAS in the block");
+  expectRefused(f + "PTMEAS/CART,0,0,0,0,0,1\n", "bad.dmi:3: PTMEAS outside a MEAS block");
+  expectRefused(f + "MEAS/PLANE,F(A),1\nPTMEAS/CART,0,0,0,0,0,1\n", "bad.dmi:3: MEAS: no ENDMES");
+  expectRefused(f + "MEAS/PLANE,F(B),1\n", "bad.dmi:3: MEAS: F(B) is not defined");
+  expectRefused(f + "MEAS/PLANE,F(A),1\nPTMEAS/CART,0,0,1O,0,0,1\nENDMES\n", "bad.dmi:4: PTMEAS: '1O' is not a number");
+  expectRefused("FILNAM/'x'\nFA(A)=FEAT/PLANE,CART,0,0,0\n", "bad.dmo:2: FEAT/PLANE: expected i,j,k", false);
+  expectRefused("FILNAM/'x'\nUNITS/FURLONG,ANGDEC\n", "bad.dmo:2: UNITS/FURLONG", false);
+}
+
+}  // namespace
+}  // namespace probeloop::interop
