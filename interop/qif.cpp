@@ -158,6 +158,7 @@ std::vector<FeatureIds> features(Writer& w, const CmmDocument& d, bool planned_p
   const std::size_t n = d.features.size();
   std::vector<int> def(n), nom(n);
   std::vector<FeatureIds> ids(n);
+  if (n == 0) return ids;  // the XSD wants every list with n >= 1: no Features section
   for (std::size_t i = 0; i < n; ++i) def[i] = w.reserve();
   for (std::size_t i = 0; i < n; ++i) nom[i] = w.reserve();
   for (std::size_t i = 0; i < n; ++i) ids[i].item = w.reserve();
@@ -295,7 +296,7 @@ std::string qifResults(const CmmDocument& results) {
   w.id(mr);
   const std::size_t n = results.features.size();
   std::vector<int> set_id(n);
-  auto* mf = w.list(mr, "MeasuredFeatures", n);
+  auto* mf = n ? w.list(mr, "MeasuredFeatures", n) : nullptr;
   std::vector<xmlNodePtr> measured(n);
   for (std::size_t i = 0; i < n; ++i) {
     const auto& f = results.features[i];
@@ -322,7 +323,7 @@ std::string qifResults(const CmmDocument& results) {
     }
     if (std::isfinite(g.form_mm)) w.add(e, "Form", length(g.form_mm));
   }
-  auto* sets = w.list(mr, "MeasuredPointSets", n);
+  auto* sets = n ? w.list(mr, "MeasuredPointSets", n) : nullptr;
   for (std::size_t i = 0; i < n; ++i) {
     const auto& f = results.features[i];
     auto* s = w.add(sets, "MeasuredPointSet");

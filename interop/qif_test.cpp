@@ -154,6 +154,21 @@ TEST(Qif, ResultsValidateAndReadBackToTheSameFeatures) {
   EXPECT_NEAR(r.characteristics[1].value, 12.5e-6, 1e-12);
 }
 
+// A sphere campaign's results: characteristics only, no features (empty lists are invalid QIF).
+TEST(Qif, ResultsWithoutFeaturesValidate) {
+  CmmDocument d;
+  d.characteristics.push_back({"EX0C cycle 2", false, -0.0012, 0.0003});
+  const std::string xml = qifResults(d);
+  if (haveSchemas()) {
+    EXPECT_EQ(schemaErrors(xml), "");
+  }
+  const auto r = parseQifResults(xml, "c.qif");
+  EXPECT_TRUE(r.features.empty());
+  ASSERT_EQ(r.characteristics.size(), 1u);
+  EXPECT_EQ(r.characteristics[0].name, "EX0C cycle 2");
+  EXPECT_EQ(xml.find("<Features>"), std::string::npos);
+}
+
 // A producer working in inches, with one point set in another declared unit and a range.
 TEST(Qif, LengthsAreConvertedToMillimetres) {
   const std::string xml = R"(<?xml version="1.0"?>

@@ -222,6 +222,15 @@ if code == 0:
     check(f"every planned point of probe_plan.qif lies on its sphere's surface (worst {worst * 1e3:.4f} um; {len(d['features'])} spheres)",
           len(d["features"]) == len(plan["features"]) and worst < 1e-5, err)
 
+    # The sphere campaign's evaluation: its results.qif (the errors of every cycle, no features).
+    code, _, err = run("synth", f"{W}/sa/plan.json", "--truth", f"{SRC}/examples/truth_rigid.yaml", "--out", f"{W}/sa-run", "--seed", "1")
+    code2, _, err2 = run("evaluate", f"{W}/sa-run/points.csv", "--manifest", f"{W}/sa/plan.json", "--out", f"{W}/sa-ev")
+    ok, e = valid(f"{W}/sa-ev/results.qif") if code == 0 and code2 == 0 else (False, err + err2)
+    check("the sphere campaign's results.qif validates against the QIF 3.0 XSD", ok, e)
+    n_char = xpath(f"{W}/sa-ev/results.qif", f"count(//{L('CharacteristicMeasurements')}/*)")
+    rows = [l for l in open(f"{W}/sa-ev/errors.csv") if l[:1].isdigit()] if ok else []
+    check(f"... with the 7 errors of each of its {len(rows)} cycles ({n_char} characteristics)", ok and n_char == str(7 * len(rows)))
+
 # --- other software's samples: counts and coordinates as xmllint --xpath gives them ---------------
 S3 = os.path.join(QIF, "samples")
 MF = f"//{L('MeasuredFeatures')}/*"
