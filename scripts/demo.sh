@@ -75,9 +75,12 @@ echo "== 7. the thermal test piece (seed 004 Ch. 7): plan -> 8 h on the virtual 
 T=$OUT/ttp
 $PL plan parts/thermal_test_piece.yaml --machine parts/machines/nmv5000.yaml --out "$T/plan" | sed -n '1,11p' | sed 's/^/   /'
 $PL simulate "$T/plan/pre_machining.nc" "$T/plan/thermal_test.nc" "$T/plan/inspection.nc" --machine parts/machines/nmv5000.yaml \
-  --part parts/thermal_test_piece.yaml --truth examples/truth_thermal_test.yaml --cmm-points "$T/plan/cmm_points.csv" \
+  --part parts/thermal_test_piece.yaml --truth examples/truth_thermal_test.yaml --cmm-points "$T/plan/cmm_plan.qif" \
   --out "$T/run" --seed 1 | sed 's/^/   /'
-$PL evaluate "$T/run/cmm_export.csv" --manifest "$T/plan/plan.json" --out "$T/cmm" --scene "$T/cmm/test_piece.gltf" |
+echo "   the CMM read the QIF 3.0 plan and answered in QIF and DMIS (docs/interop.md):"
+$PL read "$T/run/cmm_results.qif" | head -1 | sed 's/^/     /'
+$PL read "$T/run/cmm_results.dmo" | head -1 | sed 's/^/     /'
+$PL evaluate "$T/run/cmm_results.qif" --manifest "$T/plan/plan.json" --out "$T/cmm" --scene "$T/cmm/test_piece.gltf" |
   sed -n '1,12p' | sed 's/^/   /'
 $PL evaluate "$T/run/dprnt.txt" --manifest "$T/plan/plan.json" --out "$T/om" > /dev/null
 echo "   E_Y and E_TTP against the injected values (as cut; route 1 CMM, route 2 on the machine):"
@@ -198,7 +201,7 @@ echo
 echo "Outputs: $OUT/plan (G-code, manifest), $OUT/run (controller log, points.csv, inputs.csv, truth.json),"
 echo "         $OUT/eval (errors.csv, evaluation.json, report.md, campaign.gltf), $OUT/machining (cuts.json, cmm_export.csv),"
 echo "         $OUT/campaign (72 h: model.yaml, diagnosis-*.html, fit-*.html with the plots),"
-echo "         $OUT/ttp (thermal test piece: plan/, run/, cmm/ and om/ evaluations, report.html, cmm/test_piece.gltf, r-test/, fit.html),"
+echo "         $OUT/ttp (thermal test piece: plan/ (with cmm_plan.qif, .dmi), run/ (cmm_results.qif, .dmo), cmm/ (results.qif) and om/ evaluations, report.html, cmm/test_piece.gltf, r-test/, fit.html),"
 echo "         $OUT/stepped (stepped workpiece W8: plan/ with the roughing, finishing, probing programs; run/ with cmm_export.csv, sw_probe.log; eval/ with compensation.json;
          plan-compensated/, run-compensated/, eval-compensated/ with before/after; report.html;
          W6/, W1/, W7/ the thermal stages, W2/, W5/ the control parts, separation/ the campaign (control.csv), W3/plan the program predicted from it,
