@@ -142,13 +142,16 @@ $PL evaluate "$S/run-compensated/cmm_export.csv" --probe-log "$S/run-compensated
 $PL report stepped --evaluation "$S/eval-compensated/evaluation.json" --html "$S/report.html" | sed 's/^/   /'
 echo "-- the campaign (Sec. 3.5-3.6): thermal stages W6 / W1 / W7 (1000 / 3500 / 5500 rpm), W8's process error without them,"
 echo "   the control errors of W2 (transitions at 1200 mm/min) and W5 (one continuous path) against W8"
+sw_part() {  # DIR EXPERIMENT SEED: plan, cut on the virtual VMC (its waits), CMM + probe log, evaluate
+  $PL plan parts/stepped_workpiece.yaml --machine parts/machines/vmc3.yaml --out "$1/plan" --experiment "$2" > /dev/null
+  $PL simulate "$1/plan/roughing.ngc" "$1/plan/finishing.ngc" "$1/plan/probing.ngc" --machine parts/machines/vmc3.yaml \
+    --part parts/stepped_workpiece.yaml --truth examples/stepped_workpiece/truth.yaml --cmm-points "$1/plan/cmm_points.csv" \
+    --schedule "$1/plan/plan.json" --seed "$3" --out "$1/run" > /dev/null
+  $PL evaluate "$1/run/cmm_export.csv" --probe-log "$1/run/sw_probe.log" --manifest "$1/plan/plan.json" --out "$1/eval" > /dev/null
+}
 seed=11
 for W in W6 W1 W7 W2 W5; do
-  $PL plan parts/stepped_workpiece.yaml --machine parts/machines/vmc3.yaml --out "$S/$W/plan" --experiment $W > /dev/null
-  $PL simulate "$S/$W/plan/roughing.ngc" "$S/$W/plan/finishing.ngc" "$S/$W/plan/probing.ngc" --machine parts/machines/vmc3.yaml \
-    --part parts/stepped_workpiece.yaml --truth examples/stepped_workpiece/truth.yaml --cmm-points "$S/$W/plan/cmm_points.csv" \
-    --schedule "$S/$W/plan/plan.json" --seed $seed --out "$S/$W/run" > /dev/null
-  $PL evaluate "$S/$W/run/cmm_export.csv" --probe-log "$S/$W/run/sw_probe.log" --manifest "$S/$W/plan/plan.json" --out "$S/$W/eval" > /dev/null
+  sw_part "$S/$W" $W $seed
   seed=$((seed + 1))
 done
 $PL separate --stage "$S/W6/eval/evaluation.json" --stage "$S/W1/eval/evaluation.json" --stage "$S/W7/eval/evaluation.json" \
@@ -159,12 +162,7 @@ $PL plan parts/stepped_workpiece.yaml --machine parts/machines/vmc3.yaml --out "
   --predict-from "$S/separation/separation.json" | sed -n '/^Compensated/,/^Steps/p' | sed '$d' | sed 's/^/   /'
 echo "-- the model loop (§9.1 item 10): W8, W6, W1, W7 and W3 cut plain as one series, from the position error only;"
 echo "   each round adds what the diagnosis names first (its printed command)"
-$PL plan parts/stepped_workpiece.yaml --machine parts/machines/vmc3.yaml --out "$S/W3plain/plan" --experiment W3 > /dev/null
-$PL simulate "$S/W3plain/plan/roughing.ngc" "$S/W3plain/plan/finishing.ngc" "$S/W3plain/plan/probing.ngc" --machine parts/machines/vmc3.yaml \
-  --part parts/stepped_workpiece.yaml --truth examples/stepped_workpiece/truth.yaml --cmm-points "$S/W3plain/plan/cmm_points.csv" \
-  --schedule "$S/W3plain/plan/plan.json" --seed 14 --out "$S/W3plain/run" > /dev/null
-$PL evaluate "$S/W3plain/run/cmm_export.csv" --probe-log "$S/W3plain/run/sw_probe.log" --manifest "$S/W3plain/plan/plan.json" \
-  --out "$S/W3plain/eval" > /dev/null
+sw_part "$S/W3plain" W3 14
 $PL model series --part "$S/eval/evaluation.json" "$S/run/inputs.csv" --part "$S/W6/eval/evaluation.json" "$S/W6/run/inputs.csv" \
   --part "$S/W1/eval/evaluation.json" "$S/W1/run/inputs.csv" --part "$S/W7/eval/evaluation.json" "$S/W7/run/inputs.csv" \
   --part "$S/W3plain/eval/evaluation.json" "$S/W3plain/run/inputs.csv" --out "$S/series" | sed 's/^/   /'
@@ -183,12 +181,7 @@ loop_rounds() {  # DIR: add what the diagnosis names first while its score is >=
 loop_rounds "$S/series"
 echo "-- the campaign grows (the control round): W2 (walls joined at 1200 mm/min) trains, a repeat of W2 validates;"
 echo "   the model goes on from where the loop ended"
-$PL plan parts/stepped_workpiece.yaml --machine parts/machines/vmc3.yaml --out "$S/W2repeat/plan" --experiment W2 > /dev/null
-$PL simulate "$S/W2repeat/plan/roughing.ngc" "$S/W2repeat/plan/finishing.ngc" "$S/W2repeat/plan/probing.ngc" --machine parts/machines/vmc3.yaml \
-  --part parts/stepped_workpiece.yaml --truth examples/stepped_workpiece/truth.yaml --cmm-points "$S/W2repeat/plan/cmm_points.csv" \
-  --schedule "$S/W2repeat/plan/plan.json" --seed 15 --out "$S/W2repeat/run" > /dev/null
-$PL evaluate "$S/W2repeat/run/cmm_export.csv" --probe-log "$S/W2repeat/run/sw_probe.log" --manifest "$S/W2repeat/plan/plan.json" \
-  --out "$S/W2repeat/eval" > /dev/null
+sw_part "$S/W2repeat" W2 15
 $PL model series --part "$S/eval/evaluation.json" "$S/run/inputs.csv" --part "$S/W6/eval/evaluation.json" "$S/W6/run/inputs.csv" \
   --part "$S/W1/eval/evaluation.json" "$S/W1/run/inputs.csv" --part "$S/W2/eval/evaluation.json" "$S/W2/run/inputs.csv" \
   --part "$S/W7/eval/evaluation.json" "$S/W7/run/inputs.csv" --part "$S/W2repeat/eval/evaluation.json" "$S/W2repeat/run/inputs.csv" \
