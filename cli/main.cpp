@@ -261,7 +261,7 @@ int cmdEvaluate(const std::string& points_file, const std::string& manifest_file
 int cmdRead(const std::string& file, bool json) {
   const std::string text = readFile(file);
   if (interop::looksLikeDmis(text)) {  // a program (DMISMN: its nominals and PTMEAS points) or output (FILNAM)
-    const bool program = text.find("MEAS/") != std::string::npos || text.find("meas/") != std::string::npos;
+    const bool program = interop::isDmisProgram(text);
     const auto d = program ? interop::parseDmisProgram(text, file) : interop::parseDmisOutput(text, file);
     std::fputs((json ? interop::cmmDocumentJson(d) : interop::cmmDocumentText(d)).c_str(), stdout);
     return 0;

@@ -296,14 +296,25 @@ TtpPoints readTtpCmmExport(const std::string& path, const std::string& text, con
     r.p = Vector3d(t.number(row, cx), t.number(row, cy), t.number(row, cz));
     r.line = row.line;
     r.label = cf >= 0 ? row.fields[static_cast<std::size_t>(cf)] : "";
-    if (cp >= 0 && cf >= 0) {
-      const double k = t.number(row, cp);
-      if (k != std::round(k) || k < 1) throw InputError(path, r.line, "point must be a positive integer");
-      r.point = static_cast<int>(k);
-    }
     rows.push_back(r);
   }
-  return cmmPointsFromRows(path, "cmm", rows, cf >= 0, m);
+  auto out = cmmPointsFromRows(path, "cmm", rows, cf >= 0, m);
+  // The file's point numbers count only where its labels are ours (else: order of appearance).
+  if (cp >= 0 && out.assigned_by == "labels") {
+    std::map<std::pair<std::string, int>, int> seen;
+    for (std::size_t i = 0; i < out.points.size(); ++i) {
+      auto& p = out.points[i];
+      const double k = t.number(t.rows[i], cp);
+      if (k != std::round(k) || k < 1) throw InputError(path, p.line, "point must be a positive integer");
+      p.point = static_cast<int>(k);
+      const auto key = std::make_pair(p.feature, p.point);
+      if (seen.count(key))
+        throw InputError(path, p.line, "feature " + p.feature + " point " + std::to_string(p.point) + " appears twice (lines " +
+                                           std::to_string(seen[key]) + " and " + std::to_string(p.line) + ")");
+      seen[key] = p.line;
+    }
+  }
+  return out;
 }
 
 TtpPoints readTtpOnMachine(const std::string& path, const std::string& text, const std::string& format,

@@ -64,7 +64,7 @@ struct CmmMove {
 
 struct CmmDocument {
   std::string file;       // reading: the path, for messages
-  std::string part_name;  // writing: said in the document's header
+  std::string part_name;  // writing: in the DMIS program's title and the content hash of the QIF QPId
   std::vector<CmmFeature> features;
   std::vector<CmmCharacteristic> characteristics;
   std::vector<CmmMove> moves;  // reading a program: its moves (DMIS), for a collision check

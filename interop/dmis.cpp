@@ -43,6 +43,13 @@ std::string pointLabel(const std::string& id, std::size_t k) {
   return label(id + buf);
 }
 
+// A text inside '...': no quote, no '$' (a continuation or comment mark), at most 60 characters.
+std::string quoted(const std::string& t) {
+  std::string out;
+  for (char c : t.substr(0, 60)) out += c == '\'' ? '"' : c == '$' ? 'S' : c;
+  return out;
+}
+
 // One statement, continued after a comma with '$' so that no line passes 80 characters.
 void statement(std::ostringstream& o, const std::string& s) {
   std::string rest = s;
@@ -79,7 +86,7 @@ std::string dmisProgram(const CmmDocument& plan, const std::string& title) {
   for (const auto& f : plan.features)
     for (const auto& p : f.points) top = std::max(top, (p.p_mm + 5.0 * p.normal).z());
   const double clear = top + 20.0;
-  o << "DMISMN/'" << title << "',05.2\n";
+  o << "DMISMN/'" << quoted(title) << "',05.2\n";
   o << "$$ probeloop CMM plan\n";
   o << "$$ part frame, mm: the alignment must exist on the CMM before this program\n";
   o << "$$ PTMEAS ijk: the nominal outward surface normal; the probe travels along -ijk\n";
@@ -108,7 +115,7 @@ std::string dmisProgram(const CmmDocument& plan, const std::string& title) {
 
 std::string dmisOutput(const CmmDocument& results, const std::string& title) {
   std::ostringstream o;
-  o << "FILNAM/'" << title << "',05.2\n";
+  o << "FILNAM/'" << quoted(title) << "',05.2\n";
   o << "$$ probeloop simulated CMM output; part frame, mm\n";
   o << "$$ FA(<feature>_Pnn)=FEAT/POINT: the feature's measured surface points\n";
   o << "$$ (ijk: the planned outward normal)\n";
@@ -208,12 +215,21 @@ class Parser {
     if (f.size() < at + 3) fail(line, what + ": expected x,y,z");
     return Eigen::Vector3d(number(line, f[at], what), number(line, f[at + 1], what), number(line, f[at + 2], what)) * mm_per_unit;
   }
-  // A unit vector, or direction angles in degrees (any component beyond 1); zero: none.
-  Eigen::Vector3d vector(int line, const std::vector<std::string>& f, std::size_t at, const std::string& what) const {
+  // Direction cosines (normalised), or direction angles in degrees as GEOPAK writes them: a
+  // component beyond 1, all within 0..180, whose cosines form a unit vector (within 1e-3). Zero:
+  // none (a point without its vector); refused where a direction is needed (required).
+  Eigen::Vector3d vector(int line, const std::vector<std::string>& f, std::size_t at, const std::string& what, bool required) const {
     if (f.size() < at + 3) fail(line, what + ": expected i,j,k");
     Eigen::Vector3d v(number(line, f[at], what), number(line, f[at + 1], what), number(line, f[at + 2], what));
-    if (v.cwiseAbs().maxCoeff() > 1.0001) v = Eigen::Vector3d(std::cos(v.x() * M_PI / 180), std::cos(v.y() * M_PI / 180), std::cos(v.z() * M_PI / 180));
-    return v.norm() > 0 ? Eigen::Vector3d(v.normalized()) : v;
+    if (v.cwiseAbs().maxCoeff() > 1.0001 && v.minCoeff() >= 0 && v.maxCoeff() <= 180) {
+      const Eigen::Vector3d c(std::cos(v.x() * M_PI / 180), std::cos(v.y() * M_PI / 180), std::cos(v.z() * M_PI / 180));
+      if (std::fabs(c.norm() - 1) < 1e-3) v = c;
+    }
+    if (v.norm() == 0) {
+      if (required) fail(line, what + ": i,j,k is a zero vector");
+      return v;
+    }
+    return v.normalized();
   }
   double mm_per_unit = 1.0;
   std::string file_;
@@ -227,6 +243,13 @@ bool labelled(const std::string& s, std::string& prefix, std::string& lab, std::
   lab = s.substr(open + 1, close - open - 1);
   rest = s.substr(eq + 1);
   return !prefix.empty() && !lab.empty();
+}
+
+// A feature statement must carry its label: "F(X)=FEAT/..." or "FA(X)=FEAT/...".
+void requireLabel(const Parser& p, const Statement& s) {
+  std::string prefix, lab, rest;
+  if (s.text.find("=FEAT/") != std::string::npos && !labelled(s.text, prefix, lab, rest))
+    p.fail(s.line, "a FEAT statement without its label: expected F(label)=FEAT/... or FA(label)=FEAT/...");
 }
 
 // FEAT/<type>,... into a feature (kind, INNER/OUTER, geometry); false for a type we do not read.
@@ -247,13 +270,13 @@ bool feature(const Parser& p, int line, const std::string& body, CmmFeature& f, 
   auto more = [&](std::size_t k) { return a.size() >= i + k; };
   if (type == "POINT") {
     f.kind = CmmFeatureKind::Point;
-    if (more(3)) *point_normal = p.vector(line, a, i, "FEAT/POINT");
+    if (more(3)) *point_normal = p.vector(line, a, i, "FEAT/POINT", false);
   } else if (type == "PLANE") {
     f.kind = CmmFeatureKind::Plane;
-    g.direction = p.vector(line, a, i, "FEAT/PLANE");
+    g.direction = p.vector(line, a, i, "FEAT/PLANE", true);
   } else if (type == "CYLNDR" || type == "CIRCLE") {
     f.kind = type == "CYLNDR" ? CmmFeatureKind::Cylinder : CmmFeatureKind::Circle;
-    g.direction = p.vector(line, a, i, "FEAT/" + type);
+    g.direction = p.vector(line, a, i, "FEAT/" + type, true);
     if (!more(4)) p.fail(line, "FEAT/" + type + ": expected the diameter after i,j,k");
     g.diameter_mm = p.number(line, a[i + 3], "FEAT/" + type + " diameter") * p.mm_per_unit;
   } else if (type == "SPHERE") {
@@ -281,6 +304,10 @@ void units(Parser& p, const Statement& s) {
   else p.fail(s.line, "UNITS/" + a[0] + ": expected MM, CM, METER or INCH");
 }
 
+std::string unitName(double mm_per_unit) {
+  return mm_per_unit == 1.0 ? "mm" : mm_per_unit == 25.4 ? "inch" : mm_per_unit == 10.0 ? "cm" : "m";
+}
+
 void noteSkipped(CmmDocument& d, const std::map<std::string, int>& skipped) {
   for (const auto& [k, n] : skipped) d.notes.push_back(std::to_string(n) + " x " + k + " passed over");
 }
@@ -293,20 +320,28 @@ bool looksLikeDmis(const std::string& text) {
   return false;
 }
 
+bool isDmisProgram(const std::string& text) {
+  for (const auto& s : statements(text.substr(0, 4096))) return s.text.rfind("DMISMN", 0) == 0 || s.text.rfind("DMISMD", 0) == 0;
+  return false;
+}
+
 CmmDocument parseDmisProgram(const std::string& text, const std::string& file_name) {
   Parser p(file_name);
   CmmDocument d;
   d.file = file_name;
   std::map<std::string, std::size_t> index;
   std::map<std::string, int> skipped;
-  CmmFeature* meas = nullptr;
+  constexpr std::size_t none = static_cast<std::size_t>(-1);
+  std::size_t meas = none;  // an index: the vector may grow
   std::size_t expected = 0;
   int meas_line = 0;
   for (const auto& s : statements(text)) {
     std::string prefix, lab, rest;
+    requireLabel(p, s);
     if (s.text.rfind("UNITS/", 0) == 0) {
       units(p, s);
     } else if (labelled(s.text, prefix, lab, rest) && prefix == "F" && rest.rfind("FEAT/", 0) == 0) {
+      if (meas != none) p.fail(s.line, "FEAT inside the MEAS block of line " + std::to_string(meas_line) + " (its ENDMES first)");
       CmmFeature f;
       f.name = lab;
       f.line = s.line;
@@ -318,36 +353,37 @@ CmmDocument parseDmisProgram(const std::string& text, const std::string& file_na
       index[lab] = d.features.size();
       d.features.push_back(f);
     } else if (s.text.rfind("MEAS/", 0) == 0) {
-      if (meas) p.fail(s.line, "MEAS: the MEAS block of line " + std::to_string(meas_line) + " has no ENDMES");
+      if (meas != none) p.fail(s.line, "MEAS: the MEAS block of line " + std::to_string(meas_line) + " has no ENDMES");
       const auto a = split(s.text.substr(5));
       if (a.size() < 3 || a[1].rfind("F(", 0) != 0 || a[1].back() != ')') p.fail(s.line, "MEAS: expected MEAS/<type>,F(label),n");
       const std::string l = a[1].substr(2, a[1].size() - 3);
       if (!index.count(l)) p.fail(s.line, "MEAS: F(" + l + ") is not defined by a FEAT before it");
-      meas = &d.features[index[l]];
+      meas = index[l];
       const double n = p.number(s.line, a[2], "MEAS point count");
-      if (n < 1 || n != std::floor(n)) p.fail(s.line, "MEAS point count: a whole number >= 1");
+      if (n < 1 || n > 1e8 || n != std::floor(n)) p.fail(s.line, "MEAS point count: a whole number from 1 to 100000000");
       expected = static_cast<std::size_t>(n);
       meas_line = s.line;
-      meas->points.clear();
+      d.features[meas].points.clear();
     } else if (s.text.rfind("PTMEAS/", 0) == 0) {
-      if (!meas) p.fail(s.line, "PTMEAS outside a MEAS block");
+      if (meas == none) p.fail(s.line, "PTMEAS outside a MEAS block");
       const auto a = split(s.text.substr(7));
       if (a[0] != "CART") p.fail(s.line, "PTMEAS: expected CART coordinates");
       CmmPoint q;
       q.p_mm = p.point(s.line, a, 1, "PTMEAS");
-      if (a.size() >= 7) q.normal = p.vector(s.line, a, 4, "PTMEAS");
-      meas->points.push_back(q);
+      if (a.size() >= 7) q.normal = p.vector(s.line, a, 4, "PTMEAS", false);
+      d.features[meas].points.push_back(q);
       d.moves.push_back({s.line, q.p_mm, true});
     } else if (s.text.rfind("GOTO/", 0) == 0) {
       auto a = split(s.text.substr(5));
       const std::size_t at = a[0] == "CART" ? 1 : 0;
       d.moves.push_back({s.line, p.point(s.line, a, at, "GOTO"), false});
     } else if (s.text == "ENDMES") {
-      if (!meas) p.fail(s.line, "ENDMES without MEAS");
-      if (meas->points.size() != expected)
-        p.fail(meas_line, "MEAS/..,F(" + meas->name + ")," + std::to_string(expected) + ": " + std::to_string(meas->points.size()) +
+      if (meas == none) p.fail(s.line, "ENDMES without MEAS");
+      const auto& f = d.features[meas];
+      if (f.points.size() != expected)
+        p.fail(meas_line, "MEAS/..,F(" + f.name + ")," + std::to_string(expected) + ": " + std::to_string(f.points.size()) +
                               " PTMEAS in the block");
-      meas = nullptr;
+      meas = none;
     } else if (s.text.rfind("ENDFIL", 0) == 0) {
       break;
     } else if (s.text.rfind("DMISMN", 0) == 0 || s.text.rfind("DMISMD", 0) == 0) {
@@ -356,7 +392,8 @@ CmmDocument parseDmisProgram(const std::string& text, const std::string& file_na
       ++skipped[keyword(s.text)];
     }
   }
-  if (meas) p.fail(meas_line, "MEAS: no ENDMES");
+  if (meas != none) p.fail(meas_line, "MEAS: no ENDMES");
+  d.length_unit = unitName(p.mm_per_unit);
   noteSkipped(d, skipped);
   return d;
 }
@@ -376,6 +413,7 @@ CmmDocument parseDmisOutput(const std::string& text, const std::string& file_nam
   std::map<std::string, int> skipped;
   for (const auto& s : statements(text)) {
     std::string prefix, lab, rest;
+    requireLabel(p, s);
     if (s.text.rfind("UNITS/", 0) == 0) {
       units(p, s);
       continue;
@@ -419,6 +457,9 @@ CmmDocument parseDmisOutput(const std::string& text, const std::string& file_nam
       d.features.push_back(f);
     }
     auto& f = d.features[it->second];
+    if (f.kind != a.f.kind)
+      p.fail(a.f.line, (a.actual ? "FA(" : "F(") + a.f.name + ")=FEAT/: a " + cmmFeatureKindName(a.f.kind) + ", but line " +
+                           std::to_string(f.line) + " makes " + a.f.name + " a " + cmmFeatureKindName(f.kind));
     (a.actual ? f.measured : f.nominal) = a.g;
     if (a.actual) f.line = a.f.line;
     if (f.kind == CmmFeatureKind::Point && a.actual) f.points.push_back({a.g.location_mm, a.normal});
@@ -434,7 +475,7 @@ CmmDocument parseDmisOutput(const std::string& text, const std::string& file_nam
   // Features known only by a nominal were planned, not reported: not measurements.
   d.features.erase(std::remove_if(d.features.begin(), d.features.end(), [](const CmmFeature& f) { return !f.measured.given && f.points.empty(); }),
                    d.features.end());
-  d.length_unit = p.mm_per_unit == 1.0 ? "mm" : p.mm_per_unit == 25.4 ? "inch" : p.mm_per_unit == 10.0 ? "cm" : "m";
+  d.length_unit = unitName(p.mm_per_unit);
   noteSkipped(d, skipped);
   return d;
 }

@@ -40,7 +40,9 @@ std::string dmisOutput(const CmmDocument& results, const std::string& title);
 CmmDocument parseDmisProgram(const std::string& text, const std::string& file_name);
 CmmDocument parseDmisOutput(const std::string& text, const std::string& file_name);
 
-// A DMIS text: its first statement (after comments) is DMISMN or FILNAM.
+// A DMIS text: its first statement (after comments) is DMISMN or FILNAM (DMISMD); a program
+// when it is DMISMN or DMISMD.
 bool looksLikeDmis(const std::string& text);
+bool isDmisProgram(const std::string& text);
 
 }  // namespace probeloop::interop

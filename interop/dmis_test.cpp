@@ -178,6 +178,28 @@ TEST(Dmis, RefusesWhatDoesNotAddUp) {
   expectRefused(f + "MEAS/PLANE,F(A),1\nPTMEAS/CART,0,0,1O,0,0,1\nENDMES\n", "bad.dmi:4: PTMEAS: '1O' is not a number");
   expectRefused("FILNAM/'x'\nFA(A)=FEAT/PLANE,CART,0,0,0\n", "bad.dmo:2: FEAT/PLANE: expected i,j,k", false);
   expectRefused("FILNAM/'x'\nUNITS/FURLONG,ANGDEC\n", "bad.dmo:2: UNITS/FURLONG", false);
+  // Hostile or malformed: a FEAT inside a MEAS block (it would move the block's feature), a
+  // count beyond the bound, a FEAT without its label, a feature with two kinds, a zero normal.
+  expectRefused(f + "MEAS/PLANE,F(A),1\nF(B)=FEAT/PLANE,CART,0,0,0,0,0,1\nPTMEAS/CART,0,0,0,0,0,1\nENDMES\n",
+                "bad.dmi:4: FEAT inside the MEAS block of line 3");
+  expectRefused(f + "MEAS/PLANE,F(A),1E30\n", "bad.dmi:3: MEAS point count: a whole number from 1 to 100000000");
+  expectRefused("FILNAM/'x'\nFA()=FEAT/POINT,CART,0,0,0\n", "bad.dmo:2: a FEAT statement without its label", false);
+  expectRefused("FILNAM/'x'\nFA(X=FEAT/POINT,CART,0,0,0\n", "bad.dmo:2: a FEAT statement without its label", false);
+  expectRefused("FILNAM/'x'\nF(X)=FEAT/PLANE,CART,0,0,0,0,0,1\nFA(X)=FEAT/CYLNDR,INNER,CART,0,0,0,0,0,1,5\n",
+                "bad.dmo:3: FA(X)=FEAT/: a cylinder, but line 2 makes X a plane", false);
+  expectRefused("FILNAM/'x'\nFA(X)=FEAT/PLANE,CART,0,0,0,0,0,0\n", "bad.dmo:2: FEAT/PLANE: i,j,k is a zero vector", false);
+}
+
+// Cosines that are not a unit vector are normalised, not taken for direction angles; a program
+// is told from output by its first statement.
+TEST(Dmis, VectorsAndKinds) {
+  const auto d = parseDmisOutput("FILNAM/'x'\nFA(X)=FEAT/PLANE,CART,0,0,0,0,0,2\n", "v.dmo");
+  ASSERT_EQ(d.features.size(), 1u);
+  EXPECT_LT((d.features[0].measured.direction - Eigen::Vector3d::UnitZ()).norm(), 1e-12);
+  EXPECT_TRUE(isDmisProgram("$$ c\nDMISMN/'x',05.2\nENDFIL\n"));
+  EXPECT_FALSE(isDmisProgram("FILNAM/'x'\n$$ MEAS/PLANE,F(A),1\nENDFIL\n"));
+  EXPECT_TRUE(looksLikeDmis("FILNAM/'x'\n"));
+  EXPECT_EQ(parseDmisProgram("DMISMN/'x'\nUNITS/INCH,ANGDEC\nENDFIL\n", "i.dmi").length_unit, "inch");
 }
 
 }  // namespace

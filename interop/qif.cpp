@@ -3,6 +3,7 @@
 #include <libxml/parser.h>
 #include <libxml/tree.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -135,11 +136,20 @@ class Writer {
 std::string contentKey(const CmmDocument& d, const char* what) {
   std::ostringstream k;
   k << what << '|' << d.part_name;
+  auto geometry = [&](const CmmGeometry& g) {
+    if (!g.given) return;
+    k << ',' << point(g.location_mm) << ',' << unit(g.direction);
+    if (std::isfinite(g.diameter_mm)) k << ',' << length(g.diameter_mm);
+    if (std::isfinite(g.form_mm)) k << ',' << length(g.form_mm);
+  };
   for (const auto& f : d.features) {
-    k << '|' << f.name << ',' << cmmFeatureKindName(f.kind) << ',' << point(f.nominal.location_mm) << ',' << f.points.size();
-    for (const auto& p : f.points) k << ';' << point(p.p_mm);
+    k << '|' << f.name << ',' << cmmFeatureKindName(f.kind) << ',' << f.internal;
+    geometry(f.nominal);
+    geometry(f.measured);
+    for (const auto& p : f.points) k << ';' << point(p.p_mm) << ',' << unit(p.normal);
   }
-  for (const auto& c : d.characteristics) k << '|' << c.name << ',' << fixed(c.value, 12);
+  for (const auto& c : d.characteristics)
+    k << '|' << c.name << ',' << fixed(c.value, 12) << ',' << (std::isfinite(c.u) ? fixed(c.u, 12) : "-");
   return k.str();
 }
 
@@ -183,7 +193,7 @@ std::vector<FeatureIds> features(Writer& w, const CmmDocument& d, bool planned_p
     Writer::setId(e, nom[i]);
     w.add(e, "Name", f.name);
     w.add(e, "FeatureDefinitionId", std::to_string(def[i]));
-    if (planned_points) w.add(w.list(e, "PointList", 1), "WholePointSetId", std::to_string(ids[i].point_set));
+    if (planned_points && !f.points.empty()) w.add(w.list(e, "PointList", 1), "WholePointSetId", std::to_string(ids[i].point_set));
     if (f.kind == CmmFeatureKind::Cylinder) {
       auto* ax = w.add(e, "Axis");
       w.add(ax, "AxisPoint", point(f.nominal.location_mm));
@@ -202,10 +212,14 @@ std::vector<FeatureIds> features(Writer& w, const CmmDocument& d, bool planned_p
     w.add(e, "FeatureName", f.name);
     w.add(w.add(e, "DeterminationMode"), "Checked");
   }
-  if (planned_points) {
-    auto* sets = w.list(fs, "NominalPointSets", n);
+  // A feature without planned points has no set (the XSD wants n >= 1 in every list).
+  const std::size_t with_points =
+      static_cast<std::size_t>(std::count_if(d.features.begin(), d.features.end(), [](const CmmFeature& f) { return !f.points.empty(); }));
+  if (planned_points && with_points > 0) {
+    auto* sets = w.list(fs, "NominalPointSets", with_points);
     for (std::size_t i = 0; i < n; ++i) {
       const auto& f = d.features[i];
+      if (f.points.empty()) continue;
       auto* s = w.add(sets, "NominalPointSet");
       Writer::setId(s, ids[i].point_set);
       Writer::attr(s, "n", std::to_string(f.points.size()));
@@ -308,7 +322,7 @@ std::string qifResults(const CmmDocument& results) {
     const auto& f = results.features[i];
     auto* e = measured[i];
     w.add(e, "FeatureItemId", std::to_string(fids[i].item));
-    w.add(w.list(e, "PointList", 1), "WholePointSetId", std::to_string(set_id[i]));
+    if (!f.points.empty()) w.add(w.list(e, "PointList", 1), "WholePointSetId", std::to_string(set_id[i]));
     const auto& g = f.measured;
     if (!g.given) continue;
     if (f.kind == CmmFeatureKind::Cylinder) {
@@ -323,9 +337,12 @@ std::string qifResults(const CmmDocument& results) {
     }
     if (std::isfinite(g.form_mm)) w.add(e, "Form", length(g.form_mm));
   }
-  auto* sets = n ? w.list(mr, "MeasuredPointSets", n) : nullptr;
+  const std::size_t with_points = static_cast<std::size_t>(
+      std::count_if(results.features.begin(), results.features.end(), [](const CmmFeature& f) { return !f.points.empty(); }));
+  auto* sets = with_points ? w.list(mr, "MeasuredPointSets", with_points) : nullptr;
   for (std::size_t i = 0; i < n; ++i) {
     const auto& f = results.features[i];
+    if (f.points.empty()) continue;
     auto* s = w.add(sets, "MeasuredPointSet");
     Writer::setId(s, set_id[i]);
     Writer::attr(s, "count", std::to_string(f.points.size()));
@@ -401,7 +418,8 @@ class Reader {
 
   [[noreturn]] void fail(const xmlNode* n, const std::string& what) const { throw InputError(file_, n ? lineOf(n) : 0, what); }
 
-  std::vector<double> numbers(const xmlNode* n, std::size_t expected = 0) const {
+  // expected < 0: any number of values.
+  std::vector<double> numbers(const xmlNode* n, long long expected = -1) const {
     std::vector<double> v;
     std::istringstream ss(text(n));
     for (std::string tok; ss >> tok;) {
@@ -410,7 +428,7 @@ class Reader {
       if (!parseFiniteNumber(tok, x)) fail(n, local(n) + ": '" + tok + "' is not a finite number");
       v.push_back(x);
     }
-    if (expected && v.size() != expected)
+    if (expected >= 0 && v.size() != static_cast<std::size_t>(expected))
       fail(n, local(n) + ": " + std::to_string(v.size()) + " numbers, expected " + std::to_string(expected));
     return v;
   }
@@ -446,11 +464,42 @@ class Reader {
         scale_ = mmPer(lu);
         if (const auto* nm = child(lu, "UnitName")) d.length_unit = text(nm);
       }
+    if (const auto* pu = child(fu, "PrimaryUnits"))
+      for (const char* a : {"AngularUnit", "PMIAngularUnit"})
+        if (const auto* au = child(pu, a)) {
+          angle_scale_ = angleFactor(au);
+          break;
+        }
+    for (const auto* group : {child(fu, "PrimaryUnits"), child(fu, "OtherUnits")})
+      for (const auto* u : children(group))
+        if (local(u) == "AngularUnit" || local(u) == "PMIAngularUnit")
+          if (const auto* nm = child(u, "UnitName")) angular_named_[text(nm)] = u;
     // Units an element may name by its linearUnit attribute.
     for (const auto* group : {child(fu, "PrimaryUnits"), child(fu, "OtherUnits")})
       for (const auto* u : children(group))
         if (local(u) == "LinearUnit" || local(u) == "PMILinearUnit")
           if (const auto* nm = child(u, "UnitName")) named_[text(nm)] = u;
+  }
+
+  // rad per unit of the file's angle unit (degree when named so; radian otherwise), or of the
+  // element's angularUnit attribute.
+  double radPer(const xmlNode* n) const {
+    const std::string u = attribute(n, "angularUnit");
+    if (!u.empty()) {
+      const auto it = angular_named_.find(u);
+      if (it == angular_named_.end()) fail(n, "angularUnit '" + u + "' is not declared in FileUnits");
+      return angleFactor(it->second);
+    }
+    return angle_scale_;
+  }
+  double angleFactor(const xmlNode* unit_node) const {
+    if (const auto* conv = child(unit_node, "UnitConversion"))
+      if (const auto* f = child(conv, "Factor")) return numbers(f, 1)[0];  // to radians
+    const auto* nm = child(unit_node, "UnitName");
+    const std::string name = nm ? text(nm) : "";
+    if (name == "degree" || name == "degrees" || name == "deg") return M_PI / 180;
+    if (name == "radian" || name == "radians" || name == "rad") return 1.0;
+    fail(nm ? nm : unit_node, "UnitName: '" + name + "' is not an angle unit probeloop knows, and no UnitConversion/Factor is given");
   }
 
   double scaleOf(const xmlNode* n) const {
@@ -473,8 +522,8 @@ class Reader {
   double lengthOf(const xmlNode* n) const { return numbers(n, 1)[0] * scaleOf(n); }
 
   std::string file_;
-  double scale_ = 1.0;
-  std::map<std::string, const xmlNode*> named_;
+  double scale_ = 1.0, angle_scale_ = 1.0;
+  std::map<std::string, const xmlNode*> named_, angular_named_;
 };
 
 CmmFeatureKind kindOf(const std::string& qif) {
@@ -510,14 +559,32 @@ CmmGeometry geometryOf(const Reader& r, const xmlNode* e, CmmFeatureKind kind) {
 }
 
 const std::string kMeasurementSuffix = "FeatureMeasurement";
+constexpr double kMaxPoints = 1e8;  // per point set: a bound, so that 3 x count cannot overflow
 
 }  // namespace
 
 bool looksLikeQif(const std::string& text) {
-  const auto p = text.find('<');
-  if (p == std::string::npos) return false;
-  const auto head = text.substr(0, 4096);
-  return head.find("QIFDocument") != std::string::npos;
+  // The first element after the BOM, the XML declaration, comments and processing
+  // instructions: QIFDocument, with or without a namespace prefix.
+  std::size_t p = text.rfind("\xEF\xBB\xBF", 0) == 0 ? 3 : 0;
+  while (true) {
+    p = text.find_first_not_of(" \t\r\n", p);
+    if (p == std::string::npos || text[p] != '<') return false;
+    if (text.compare(p, 4, "<!--") == 0) {
+      p = text.find("-->", p);
+      if (p == std::string::npos) return false;
+      p += 3;
+    } else if (text.compare(p, 2, "<?") == 0 || text.compare(p, 2, "<!") == 0) {
+      p = text.find('>', p);
+      if (p == std::string::npos) return false;
+      ++p;
+    } else {
+      const auto end = text.find_first_of(" \t\r\n/>", p);
+      const std::string name = text.substr(p + 1, end == std::string::npos ? std::string::npos : end - p - 1);
+      const auto colon = name.find(':');
+      return (colon == std::string::npos ? name : name.substr(colon + 1)) == "QIFDocument";
+    }
+  }
 }
 
 namespace {
@@ -532,13 +599,20 @@ struct OpenedQif {
 // Parses, checks the root, namespace and version, reads the units.
 OpenedQif openQif(const std::string& xml, const std::string& file_name) {
   xmlDocPtr raw = xmlReadMemory(xml.data(), static_cast<int>(xml.size()), file_name.c_str(), nullptr,
-                                XML_PARSE_NONET | XML_PARSE_NOERROR | XML_PARSE_NOWARNING | XML_PARSE_HUGE);
+                                XML_PARSE_NONET | XML_PARSE_NOERROR | XML_PARSE_NOWARNING | XML_PARSE_HUGE | XML_PARSE_BIG_LINES);
   if (!raw) {
     const xmlError* e = xmlGetLastError();
     throw InputError(file_name, e ? e->line : 0,
                      std::string("not well-formed XML: ") + (e && e->message ? e->message : "unreadable"));
   }
   OpenedQif q{DocPtr(raw), Reader(file_name), nullptr, {}};
+  // Entities are not expanded by the parser but would be by xmlNodeGetContent (an exponential
+  // "billion laughs"): QIF needs no DTD, so a document with one is refused.
+  if (q.doc->intSubset || q.doc->extSubset) {
+    const auto at = xml.find("<!DOCTYPE");
+    const int line = at == std::string::npos ? 0 : 1 + static_cast<int>(std::count(xml.begin(), xml.begin() + static_cast<long>(at), '\n'));
+    throw InputError(file_name, line, "a DOCTYPE (DTD or entity declarations): QIF documents have none; not read");
+  }
   const xmlNode* root = xmlDocGetRootElement(q.doc.get());
   q.root = root;
   auto& r = q.r;
@@ -568,7 +642,8 @@ std::pair<std::size_t, std::size_t> selected(const Reader& r, const xmlNode* ref
   if (rt == "RangePointSetId") {
     std::istringstream rs(attribute(ref, "range"));
     long a = 0, b = 0;
-    if (!(rs >> a >> b) || a < 1 || b < a || static_cast<std::size_t>(b) > n)
+    std::string extra;
+    if (!(rs >> a >> b) || (rs >> extra) || a < 1 || b < a || static_cast<std::size_t>(b) > n)
       r.fail(ref, "RangePointSetId: range '" + attribute(ref, "range") + "' is not within 1.." + std::to_string(n));
     return {static_cast<std::size_t>(a - 1), static_cast<std::size_t>(b)};
   }
@@ -710,12 +785,16 @@ CmmDocument parseQifResults(const std::string& xml, const std::string& file_name
         const auto* pts = child(ps, "Points");
         if (!pts) r.fail(ps, "MeasuredPointSet " + id + ": no Points");
         double count = 0;
-        if (!parseFiniteNumber(attribute(ps, "count"), count) || count < 0 || count != std::floor(count))
-          r.fail(ps, "MeasuredPointSet " + id + ": count '" + attribute(ps, "count") + "' is not a whole number");
+        if (!parseFiniteNumber(attribute(ps, "count"), count) || count < 0 || count > kMaxPoints || count != std::floor(count))
+          r.fail(ps, "MeasuredPointSet " + id + ": count '" + attribute(ps, "count") + "' is not a whole number from 0 to " +
+                         std::to_string(static_cast<long long>(kMaxPoints)));
+        if (child(ps, "Units") || child(ps, "CoordinateSystemId") || child(ps, "TranformId"))
+          r.fail(ps, "MeasuredPointSet " + id + ": its own Units or coordinate system are not read (export the points in the file's "
+                                             "units and frame)");
         const auto n = static_cast<std::size_t>(count);
-        const auto xyz = r.numbers(pts, 3 * n);
+        const auto xyz = r.numbers(pts, 3 * static_cast<long long>(n));
         std::vector<double> nrm;
-        if (const auto* nn = child(ps, "Normals")) nrm = r.numbers(nn, 3 * n);
+        if (const auto* nn = child(ps, "Normals")) nrm = r.numbers(nn, 3 * static_cast<long long>(n));
         const double s = attribute(pts, "linearUnit").empty() ? r.scaleOf(ps) : r.scaleOf(pts);
         const auto [from, to] = selected(r, ref, n);
         for (std::size_t k = from; k < to; ++k) {
@@ -737,10 +816,13 @@ CmmDocument parseQifResults(const std::string& xml, const std::string& file_name
         CmmCharacteristic ch;
         const auto* item = child(c, "CharacteristicItemId");
         ch.name = item && char_item_name.count(text(item)) ? char_item_name[text(item)] : local(c);
-        ch.angular = local(c).find("Angular") != std::string::npos;
-        ch.value = r.numbers(v, 1)[0] * (ch.angular ? 1.0 : r.scaleOf(v));
+        // Angles: the user-defined angular and the angle types (not Angularity, a zone in length).
+        const std::string t = local(c);
+        ch.angular = t.rfind("UserDefinedAngular", 0) == 0 || t.rfind("Angle", 0) == 0 || t.rfind("AngularCoordinate", 0) == 0;
+        const double scale = ch.angular ? r.radPer(v) : r.scaleOf(v);
+        ch.value = r.numbers(v, 1)[0] * scale;
         double u = 0;
-        if (parseFiniteNumber(attribute(v, "combinedUncertainty"), u)) ch.u = u * (ch.angular ? 1.0 : r.scaleOf(v));
+        if (parseFiniteNumber(attribute(v, "combinedUncertainty"), u)) ch.u = u * scale;
         d.characteristics.push_back(ch);
       }
   }

@@ -228,6 +228,52 @@ TEST(Qif, RefusesWhatIsNotQif3OrDoesNotAddUp) {
   std::string unit = good;
   unit.replace(unit.find("<UnitName>mm<"), 13, "<UnitName>furlong<");
   expectRefused(unit, "UnitName: 'furlong' is not a length unit");
+  // Counts: beyond the bound (3 x count would overflow), and 0 with points given.
+  std::string huge = good;
+  huge.replace(huge.find("count=\"5\""), 9, "count=\"6148914691236517888\"");
+  expectRefused(huge, "count '6148914691236517888' is not a whole number from 0 to 100000000");
+  std::string zero = good;
+  zero.replace(zero.find("count=\"5\""), 9, "count=\"0\"");
+  expectRefused(zero, "Points: 15 numbers, expected 0");
+  // A point set in its own units.
+  std::string own = good;
+  own.replace(own.find("<Points>"), 8, "<Units><LinearUnit><UnitName>inch</UnitName></LinearUnit></Units><Points>");
+  expectRefused(own, "its own Units or coordinate system are not read");
+  // A DOCTYPE (entity declarations would expand in the text): refused.
+  expectRefused("<?xml version=\"1.0\"?>\n<!DOCTYPE QIFDocument [<!ENTITY a \"1 2 3\">]>\n"
+                "<QIFDocument xmlns=\"http://qifstandards.org/xsd/qif3\" versionQIF=\"3.0.0\"/>",
+                "bad.qif:2: a DOCTYPE");
+}
+
+// Detection looks past a long prolog (the XML declaration, comments), and only at the root.
+TEST(Qif, DetectedByItsRootElement) {
+  EXPECT_TRUE(looksLikeQif("\xEF\xBB\xBF<?xml version=\"1.0\"?>\n<!--" + std::string(10000, 'x') + "-->\n<q:QIFDocument xmlns:q=\"x\">"));
+  EXPECT_FALSE(looksLikeQif("<Other><QIFDocument/></Other>"));
+  EXPECT_FALSE(looksLikeQif("feature,point,x_mm\nQIFDocument,1,2\n"));
+}
+
+// A feature measured without points (lists in QIF need n >= 1) and angular values in degrees;
+// Angularity is a zone in length, not an angle.
+TEST(Qif, FeaturesWithoutPointsAndAnglesInDegrees) {
+  auto d = sample();
+  d.features[1].points.clear();
+  if (haveSchemas()) {
+    EXPECT_EQ(schemaErrors(qifResults(d)), "");
+    EXPECT_EQ(schemaErrors(qifPlan(d)), "");
+  }
+  EXPECT_TRUE(parseQifResults(qifResults(d), "r.qif").features[1].points.empty());
+  const std::string xml = R"(<QIFDocument xmlns="http://qifstandards.org/xsd/qif3" versionQIF="3.0.0" idMax="9">
+ <FileUnits><PrimaryUnits><AngularUnit><UnitName>degree</UnitName></AngularUnit><LinearUnit><UnitName>mm</UnitName></LinearUnit></PrimaryUnits></FileUnits>
+ <Results><MeasurementResultsSet n="1"><MeasurementResults id="1"><MeasuredCharacteristics><CharacteristicMeasurements n="2">
+  <AngleBetweenCharacteristicMeasurement id="2"><Value>90</Value></AngleBetweenCharacteristicMeasurement>
+  <AngularityCharacteristicMeasurement id="3"><Value>0.095</Value></AngularityCharacteristicMeasurement>
+ </CharacteristicMeasurements></MeasuredCharacteristics></MeasurementResults></MeasurementResultsSet></Results></QIFDocument>)";
+  const auto r = parseQifResults(xml, "a.qif");
+  ASSERT_EQ(r.characteristics.size(), 2u);
+  EXPECT_TRUE(r.characteristics[0].angular);
+  EXPECT_NEAR(r.characteristics[0].value, M_PI / 2, 1e-12);
+  EXPECT_FALSE(r.characteristics[1].angular);
+  EXPECT_NEAR(r.characteristics[1].value, 0.095, 1e-12);
 }
 
 // Other software's files (../shared/refdata/qif3/samples); the expected numbers are what

@@ -31,9 +31,10 @@ bool isEventOrSwitch(const std::string& c) { return c == "tool_changes" || c == 
 
 SteppedSeries buildSteppedSeries(const std::vector<SteppedSeriesPart>& parts, double gap_s, int training_parts) {
   if (parts.empty()) throw InputError("", 0, "model series: no parts given");
-  if (training_parts < 0 || training_parts > static_cast<int>(parts.size()))
-    throw InputError("", 0, "model series: --train-parts " + std::to_string(training_parts) + ": between 1 and the " +
-                                std::to_string(parts.size()) + " parts given (0: the first 60 % of the steps)");
+  if (training_parts < 0 || training_parts >= static_cast<int>(parts.size()))
+    throw InputError("", 0, "model series: --train-parts " + std::to_string(training_parts) + ": between 1 and " +
+                                std::to_string(parts.size() - 1) + " (of the " + std::to_string(parts.size()) +
+                                " parts given, at least one must validate)");
   int training_rows = 0;
   const auto& names = parts.front().inputs.names;
   const double step = parts.front().inputs.step_s;

@@ -101,6 +101,10 @@ TEST(SteppedSeries, TheFirstPartsTrainWhenAsked) {
   const auto in = parseCsv(s.inputs_csv, "inputs.csv");
   EXPECT_DOUBLE_EQ(in.number(in.rows.back(), in.column("transition_feed_mm_per_min")), 0);
   EXPECT_THROW(buildSteppedSeries({{evaluation("W8", 200), "w8.json", log("w8.csv", 20)}}, 60.0, 2), InputError);
+  // Every part training leaves nothing to validate on.
+  EXPECT_THROW(buildSteppedSeries({{evaluation("W8", 200), "w8.json", log("w8.csv", 20)}, {evaluation("W6", 400), "w6.json", log("w6.csv", 22)}},
+                                  60.0, 2),
+               InputError);
   auto old = evaluation("W8", 200);
   old.erase("transition");
   EXPECT_THROW(buildSteppedSeries({{old, "w8.json", log("w8.csv", 20)}}), InputError);

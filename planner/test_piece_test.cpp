@@ -121,7 +121,7 @@ TEST(PlanTestPiece, TheThermalTestPieceGivesThreeProgramsTheCmmPlanAndASummary) 
   EXPECT_NE(plan.files[0].second.find("feature,point,x_mm,y_mm,z_mm,nx,ny,nz\nTOP,1,"), std::string::npos);
   EXPECT_EQ(plan.files[1].first, "cmm_plan.qif");
   // The datum band CYL is a boss (its outward normals point away from the axis); the QIF plan
-  // names every feature of the CSV (checked against the schema in tests/integration/qif_cli.py).
+  // names every feature of the CSV (checked against the schema in tests/integration/cmm_interop_cli.py).
   EXPECT_NE(plan.files[1].second.find("<InternalExternal>EXTERNAL</InternalExternal>"), std::string::npos);
   EXPECT_EQ(plan.files[1].second.find("INTERNAL"), std::string::npos);
   EXPECT_NE(plan.files[1].second.find("<FeatureName>X2_9</FeatureName>"), std::string::npos);

@@ -1,5 +1,7 @@
 #include "sim/cmm_stage.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <random>
 #include <sstream>
@@ -43,6 +45,19 @@ std::vector<CmmPoint> cmmPointsOfQifPlan(const interop::CmmDocument& plan) {
   std::vector<CmmPoint> out;
   for (const auto& f : plan.features) {
     if (f.name.empty()) throw InputError(plan.file, f.line, "a feature nominal without a Name (the export names each point's feature)");
+    // What the CMM answers in must hold it (checked before the machine runs for hours).
+    const bool kind_ok = f.kind == interop::CmmFeatureKind::Plane || f.kind == interop::CmmFeatureKind::Sphere ||
+                         f.kind == interop::CmmFeatureKind::Cylinder;
+    if (!kind_ok)
+      throw InputError(plan.file, f.line, "feature " + f.name + ": a " + (f.kind_name.empty() ? cmmFeatureKindName(f.kind) : f.kind_name) +
+                                              "; the simulated CMM measures planes, spheres and cylinders");
+    const bool label_ok = f.name.size() <= 13 && std::isalpha(static_cast<unsigned char>(f.name[0])) &&
+                          std::all_of(f.name.begin(), f.name.end(), [](unsigned char c) { return std::isalnum(c) || c == '_'; });
+    if (!label_ok)
+      throw InputError(plan.file, f.line, "feature '" + f.name + "': its DMIS labels need [A-Za-z][A-Za-z0-9_]*, at most 13 characters "
+                                                              "(+ _Pnn for its points within 16)");
+    if (!f.nominal.given || (f.kind != interop::CmmFeatureKind::Plane && !std::isfinite(f.nominal.diameter_mm)))
+      throw InputError(plan.file, f.line, "feature " + f.name + ": no nominal geometry (location, and the diameter of a sphere or cylinder)");
     int k = 0;
     for (const auto& q : f.points) {
       CmmPoint p;

@@ -37,8 +37,9 @@ struct CmmPoint {
 
 std::vector<CmmPoint> readCmmPoints(const std::string& path);
 // A QIF 3.0 plan (interop/qif.hpp readQifPlan) as the CMM's points: each feature's planned
-// points in order, numbered from 1, line = the feature nominal's line; a point without its
-// Normal is refused (the CMM approaches along it).
+// points in order, numbered from 1, line = the feature nominal's line. Refused before anything
+// runs: a point without its Normal (the CMM approaches along it), a feature other than a plane,
+// sphere or cylinder, one without its nominal geometry, or whose name cannot be a DMIS label.
 std::vector<CmmPoint> cmmPointsOfQifPlan(const interop::CmmDocument& plan);  // a DMIS program's too
 
 // alpha_per_K: the part's real expansion coefficient (NaN: the workpiece material's).

@@ -205,6 +205,15 @@ if code == 0:
         check("W8's results.qif names e_pos_x, e_proc_y and e_splz of each step",
               all(f"{q} step {k}" in names for q in ("e_pos_x", "e_proc_y", "e_splz") for k in range(1, 5)), sorted(names)[:12])
 
+# A plan from other software with features the simulated CMM does not measure: refused at once,
+# naming the feature, before hours of machining are simulated.
+widget = os.path.join(QIF, "samples", "WIDGET_QIF_RESULTS_W_QPIDS.QIF")
+code, _, err = run("simulate", "roughing.ngc", "finishing.ngc", "probing.ngc", "--machine", f"{SRC}/parts/machines/vmc3.yaml",
+                   "--part", f"{SRC}/parts/stepped_workpiece.yaml", "--truth", f"{SRC}/examples/stepped_workpiece/truth.yaml",
+                   "--cmm-points", widget, "--schedule", "plan.json", "--out", f"{W}/bad-widget", cwd=f"{S}/plan")
+check("a QIF plan with a circle is refused before the simulation, naming it; nothing written",
+      code != 0 and ": a Circle; the simulated CMM measures planes, spheres and cylinders" in err and not os.path.exists(f"{W}/bad-widget"), err)
+
 # --- the sphere artifact's probing plan ----------------------------------------------------------
 code, out, err = run("plan", f"{SRC}/parts/sphere_artifact.yaml", "--machine", f"{SRC}/parts/machines/nmv5000.yaml", "--out", f"{W}/sa")
 ok, e = valid(f"{W}/sa/probe_plan.qif")
