@@ -10,62 +10,20 @@
 #include <sstream>
 
 #include "core/error.hpp"
+#include "interop/test_documents.hpp"
 
 namespace probeloop::interop {
 namespace {
 
-CmmDocument plan() {
-  CmmDocument d;
-  d.part_name = "test";
-  CmmFeature p;
-  p.name = "X1_3";
-  p.kind = CmmFeatureKind::Plane;
-  p.nominal = {true, {50, 25, 10}, {0, 0, 1}, NAN, NAN};
-  for (double x : {40.0, 60.0})
-    for (double y : {15.0, 35.0}) p.points.push_back({{x, y, 10}, {0, 0, 1}});
-  d.features.push_back(p);
-  CmmFeature c;
-  c.name = "BORE1";
-  c.kind = CmmFeatureKind::Cylinder;
-  c.internal = true;
-  c.nominal = {true, {100, 50, -10}, {0, 0, 1}, 20, NAN};
-  for (int k = 0; k < 6; ++k) {
-    const double a = k * M_PI / 3;
-    const Eigen::Vector3d r(std::cos(a), std::sin(a), 0);
-    c.points.push_back({Eigen::Vector3d(100, 50, k % 2 ? -5 : -15) + 10 * r, -r});
-  }
-  d.features.push_back(c);
-  CmmFeature s;
-  s.name = "SPH1";
-  s.kind = CmmFeatureKind::Sphere;
-  s.nominal = {true, {150, 50, 12.5}, {0, 0, 0}, 25, NAN};
-  for (const Eigen::Vector3d& n : {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(1, 0, 1).normalized(), Eigen::Vector3d(0, 1, 1).normalized(),
-                                   Eigen::Vector3d(-1, 0, 1).normalized(), Eigen::Vector3d(0, -1, 1).normalized()})
-    s.points.push_back({s.nominal.location_mm + 12.5 * n, n});
-  d.features.push_back(s);
-  return d;
-}
+CmmDocument plan() { return testing::ballPlaneBore(); }
 
 TEST(Dmis, AProgramReadsBackToItsFeaturesAndPoints) {
   const auto a = plan();
   const std::string text = dmisProgram(a, "TEST PLAN");
   const auto b = parseDmisProgram(text, "plan.dmi");
-  ASSERT_EQ(b.features.size(), 3u);
-  for (std::size_t i = 0; i < 3; ++i) {
-    const auto& x = a.features[i];
-    const auto& y = b.features[i];
-    EXPECT_EQ(y.name, x.name);
-    EXPECT_EQ(y.kind, x.kind);
-    EXPECT_EQ(y.internal, x.internal);
-    EXPECT_LT((y.nominal.location_mm - x.nominal.location_mm).norm(), 1e-6);
-    ASSERT_EQ(y.points.size(), x.points.size());
-    for (std::size_t k = 0; k < x.points.size(); ++k) {
-      EXPECT_LT((y.points[k].p_mm - x.points[k].p_mm).norm(), 1e-6);
-      EXPECT_LT((y.points[k].normal - x.points[k].normal).norm(), 1e-6);  // written to 6 decimals
-    }
-  }
-  EXPECT_NEAR(b.features[1].nominal.diameter_mm, 20, 1e-9);
-  EXPECT_NEAR(b.features[2].nominal.diameter_mm, 25, 1e-9);
+  testing::expectSamePlan(a, b, 1e-6);  // vectors written to 6 decimals
+  EXPECT_NEAR(b.features[0].nominal.diameter_mm, 25, 1e-9);
+  EXPECT_NEAR(b.features[2].nominal.diameter_mm, 20, 1e-9);
   EXPECT_EQ(text.rfind("DMISMN/'TEST PLAN',05.2\n", 0), 0u);
   EXPECT_NE(text.find("\nMEAS/CYLNDR,F(BORE1),6\n"), std::string::npos);
   EXPECT_NE(text.find("\nENDFIL\n"), std::string::npos);
@@ -111,19 +69,19 @@ TEST(Dmis, OutputReadsBackToMeasuredFeaturesWithTheirPoints) {
     f.measured.location_mm += Eigen::Vector3d(0.001, -0.002, 0.0005);
     for (auto& p : f.points) p.p_mm += 0.0013 * p.normal;
   }
-  r.features[2].measured.given = false;  // a feature without a fit: points only
+  r.features[0].measured.given = false;  // a feature without a fit: points only
   const auto d = parseDmisOutput(dmisOutput(r, "RUN"), "run.dmo");
   ASSERT_EQ(d.features.size(), 3u);
   for (std::size_t i = 0; i < 3; ++i) {
     EXPECT_EQ(d.features[i].name, r.features[i].name);
     EXPECT_EQ(d.features[i].kind, r.features[i].kind);
-    EXPECT_EQ(d.features[i].measured.given, i < 2);
+    EXPECT_EQ(d.features[i].measured.given, i > 0);
     ASSERT_EQ(d.features[i].points.size(), r.features[i].points.size());
     for (std::size_t k = 0; k < r.features[i].points.size(); ++k)
       EXPECT_LT((d.features[i].points[k].p_mm - r.features[i].points[k].p_mm).norm(), 1e-6);
   }
-  EXPECT_LT((d.features[0].measured.location_mm - r.features[0].measured.location_mm).norm(), 1e-6);
-  EXPECT_TRUE(d.features[1].internal);
+  EXPECT_LT((d.features[1].measured.location_mm - r.features[1].measured.location_mm).norm(), 1e-6);
+  EXPECT_TRUE(d.features[2].internal);
   EXPECT_GT(d.features[0].line, 0);
 }
 

@@ -11,6 +11,7 @@
 #include <filesystem>
 
 #include "core/error.hpp"
+#include "interop/test_documents.hpp"
 
 namespace probeloop::interop {
 namespace {
@@ -42,42 +43,7 @@ std::string schemaErrors(const std::string& xml) {
 
 bool haveSchemas() { return fs::exists(qifDir() / "QIFApplications" / "QIFDocument.xsd"); }
 
-// Two spheres on a table, a plane and a bore, each with its points (outward normals).
-CmmDocument sample() {
-  CmmDocument d;
-  d.part_name = "test";
-  CmmFeature s;
-  s.name = "S1";
-  s.kind = CmmFeatureKind::Sphere;
-  s.nominal.location_mm = {100, 50, 20};
-  s.nominal.diameter_mm = 25;
-  for (const Eigen::Vector3d& n : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(-1, 0, 0),
-                                  Eigen::Vector3d(0, -1, 0), Eigen::Vector3d(0, 0, 1)})
-    s.points.push_back({s.nominal.location_mm + 12.5 * n, n});
-  d.features.push_back(s);
-  CmmFeature p;
-  p.name = "TOP";
-  p.kind = CmmFeatureKind::Plane;
-  p.nominal.location_mm = {0, 0, 0};
-  p.nominal.direction = {0, 0, 1};
-  for (double x : {-10.0, 10.0})
-    for (double y : {-10.0, 10.0}) p.points.push_back({{x, y, 0}, {0, 0, 1}});
-  d.features.push_back(p);
-  CmmFeature c;
-  c.name = "CYL";
-  c.kind = CmmFeatureKind::Cylinder;
-  c.internal = true;
-  c.nominal.location_mm = {0, 0, -5};
-  c.nominal.direction = {0, 0, 1};
-  c.nominal.diameter_mm = 20;
-  for (int k = 0; k < 6; ++k) {
-    const double a = k * M_PI / 3;
-    const Eigen::Vector3d r(std::cos(a), std::sin(a), 0);
-    c.points.push_back({c.nominal.location_mm + 10 * r + Eigen::Vector3d(0, 0, k % 2 ? 2 : -2), -r});
-  }
-  d.features.push_back(c);
-  return d;
-}
+CmmDocument sample() { return testing::ballPlaneBore(); }
 
 TEST(Qif, APlanValidatesAgainstTheSchema) {
   if (!haveSchemas()) GTEST_SKIP() << "no " << qifDir();
@@ -90,23 +56,7 @@ TEST(Qif, APlanValidatesAgainstTheSchema) {
 TEST(Qif, APlanReadsBackToItsFeaturesAndPoints) {
   const auto a = sample();
   const auto b = parseQifPlan(qifPlan(a), "plan.qif");
-  ASSERT_EQ(b.features.size(), a.features.size());
-  for (std::size_t i = 0; i < a.features.size(); ++i) {
-    const auto& x = a.features[i];
-    const auto& y = b.features[i];
-    EXPECT_EQ(y.name, x.name);
-    EXPECT_EQ(y.kind, x.kind);
-    EXPECT_EQ(y.internal, x.internal);
-    EXPECT_LT((y.nominal.location_mm - x.nominal.location_mm).norm(), 1e-6);
-    if (x.kind != CmmFeatureKind::Plane) {
-      EXPECT_NEAR(y.nominal.diameter_mm, x.nominal.diameter_mm, 1e-9);
-    }
-    ASSERT_EQ(y.points.size(), x.points.size());
-    for (std::size_t k = 0; k < x.points.size(); ++k) {
-      EXPECT_LT((y.points[k].p_mm - x.points[k].p_mm).norm(), 1e-6);
-      EXPECT_LT((y.points[k].normal - x.points[k].normal).norm(), 1e-8);
-    }
-  }
+  testing::expectSamePlan(a, b, 1e-8);  // directions written to 1e-9
   EXPECT_THROW(parseQifPlan(qifResults(CmmDocument{}), "empty.qif"), InputError);
 }
 
@@ -214,31 +164,25 @@ TEST(Qif, RefusesWhatIsNotQif3OrDoesNotAddUp) {
   auto d = sample();
   d.features.resize(1);
   const std::string good = qifResults(d);
-  std::string miscount = good;
-  miscount.replace(miscount.find("count=\"5\""), 9, "count=\"6\"");
-  expectRefused(miscount, "Points: 15 numbers, expected 18");
-  std::string dangling = good;
-  const auto p = dangling.find("<WholePointSetId>") + 17;
-  dangling.replace(p, dangling.find('<', p) - p, "99");
-  expectRefused(dangling, "WholePointSetId: no MeasuredPointSet with id 99");
-  std::string nan = good;
-  const auto q = nan.find("<Points>") + 8;
-  nan.replace(q, 3, "NaN");
-  expectRefused(nan, "' is not a finite number");
-  std::string unit = good;
-  unit.replace(unit.find("<UnitName>mm<"), 13, "<UnitName>furlong<");
-  expectRefused(unit, "UnitName: 'furlong' is not a length unit");
+  // The good document with its first `from` replaced by `to`.
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string t = good;
+    t.replace(t.find(from), from.size(), to);
+    return t;
+  };
+  expectRefused(with("count=\"5\"", "count=\"6\""), "Points: 15 numbers, expected 18");
+  const auto p = good.find("<WholePointSetId>") + 17;
+  expectRefused(with(good.substr(p, good.find('<', p) - p) + "</WholePointSetId>", "99</WholePointSetId>"),
+                "WholePointSetId: no MeasuredPointSet with id 99");
+  expectRefused(with("<Points>", "<Points>NaN "), "Points: 'NaN' is not a finite number");
+  expectRefused(with("<UnitName>mm<", "<UnitName>furlong<"), "UnitName: 'furlong' is not a length unit");
   // Counts: beyond the bound (3 x count would overflow), and 0 with points given.
-  std::string huge = good;
-  huge.replace(huge.find("count=\"5\""), 9, "count=\"6148914691236517888\"");
-  expectRefused(huge, "count '6148914691236517888' is not a whole number from 0 to 100000000");
-  std::string zero = good;
-  zero.replace(zero.find("count=\"5\""), 9, "count=\"0\"");
-  expectRefused(zero, "Points: 15 numbers, expected 0");
+  expectRefused(with("count=\"5\"", "count=\"6148914691236517888\""),
+                "count '6148914691236517888' is not a whole number from 0 to 100000000");
+  expectRefused(with("count=\"5\"", "count=\"0\""), "Points: 15 numbers, expected 0");
   // A point set in its own units.
-  std::string own = good;
-  own.replace(own.find("<Points>"), 8, "<Units><LinearUnit><UnitName>inch</UnitName></LinearUnit></Units><Points>");
-  expectRefused(own, "its own Units or coordinate system are not read");
+  expectRefused(with("<Points>", "<Units><LinearUnit><UnitName>inch</UnitName></LinearUnit></Units><Points>"),
+                "its own Units or coordinate system are not read");
   // A DOCTYPE (entity declarations would expand in the text): refused.
   expectRefused("<?xml version=\"1.0\"?>\n<!DOCTYPE QIFDocument [<!ENTITY a \"1 2 3\">]>\n"
                 "<QIFDocument xmlns=\"http://qifstandards.org/xsd/qif3\" versionQIF=\"3.0.0\"/>",
