@@ -9,14 +9,6 @@
 
 namespace probeloop::evaluate {
 
-namespace {
-
-bool endsWith(const std::string& s, const std::string& t) {
-  return s.size() >= t.size() && s.compare(s.size() - t.size(), t.size(), t) == 0;
-}
-
-}  // namespace
-
 std::string evaluationQif(const parts::PlanManifest& m, const TtpPoints* points, const std::string& errors_csv) {
   interop::CmmDocument d;
   d.part_name = m.part_name;
@@ -44,7 +36,7 @@ std::string evaluationQif(const parts::PlanManifest& m, const TtpPoints* points,
     const std::string id = id_col >= 0 ? row.fields[static_cast<std::size_t>(id_col)] : std::to_string(row.line);
     for (std::size_t c = 0; c < t.header.size(); ++c) {
       const std::string& h = t.header[c];
-      const bool um = endsWith(h, "_um"), urad = endsWith(h, "_urad");
+      const bool um = h.ends_with("_um"), urad = h.ends_with("_urad");
       if ((!um && !urad) || h.rfind("U_", 0) == 0 || h.rfind("u_", 0) == 0) continue;
       double v = 0;
       if (!t.tryNumber(row, static_cast<int>(c), v)) continue;

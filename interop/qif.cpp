@@ -673,7 +673,7 @@ CmmDocument parseQifPlan(const std::string& xml, const std::string& file_name) {
   const std::string suffix = "FeatureNominal";
   for (const auto* e : children(child(fs, "FeatureNominals"))) {
     const std::string tag = local(e);
-    if (tag.size() <= suffix.size() || tag.compare(tag.size() - suffix.size(), std::string::npos, suffix) != 0) continue;
+    if (tag.size() <= suffix.size() || !tag.ends_with(suffix)) continue;
     CmmFeature f;
     f.kind_name = tag.substr(0, tag.size() - suffix.size());
     f.kind = kindOf(f.kind_name);
@@ -742,7 +742,7 @@ CmmDocument parseQifResults(const std::string& xml, const std::string& file_name
     for (const auto* ps : children(child(mr, "MeasuredPointSets"), "MeasuredPointSet")) point_sets[attribute(ps, "id")] = ps;
     for (const auto* m : children(child(mr, "MeasuredFeatures"))) {
       const std::string tag = local(m);
-      if (tag.size() <= kMeasurementSuffix.size() || tag.compare(tag.size() - kMeasurementSuffix.size(), std::string::npos, kMeasurementSuffix) != 0) {
+      if (tag.size() <= kMeasurementSuffix.size() || !tag.ends_with(kMeasurementSuffix)) {
         d.notes.push_back("line " + std::to_string(lineOf(m)) + ": " + tag + " passed over (not a feature measurement)");
         continue;
       }
