@@ -1,0 +1,350 @@
+// Input checks, moments and result assembly of the least-squares fits (ls_detail.hpp).
+#include <cstdint>
+#include <cstdio>
+#include <numeric>
+
+#include "core/error.hpp"
+#include "geometry/ls_detail.hpp"
+
+namespace probeloop::geometry::ls {
+
+std::string num(double v, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+  return buf;
+}
+std::string um(double mm) { return num(mm * 1000.0, 2) + " um"; }
+std::string degrees(double rad) { return num(rad * 180.0 / kPi, 3) + " deg"; }
+std::string name(ElementKind k) { return std::string(elementName(k)); }
+void fail(const std::string& message) { throw GeometryError(message); }
+
+bool isPlanar(ElementKind k) { return k == ElementKind::Line2D || k == ElementKind::Circle2D; }
+
+Vector3d canonical(const Vector3d& d) {
+  int k = 0;
+  d.cwiseAbs().maxCoeff(&k);
+  return d(k) < 0.0 ? Vector3d(-d) : d;
+}
+
+// Duff et al., "Building an orthonormal basis, revisited", JCGT 6(1), 2017: continuous
+// except at d.z = 0, no division by ~0.
+Matrix3d frameOf(const Vector3d& d) {
+  const double sign = std::copysign(1.0, d.z());
+  const double a = -1.0 / (sign + d.z());
+  const double b = d.x() * d.y() * a;
+  Matrix3d u;
+  u.row(0) << 1.0 + sign * d.x() * d.x() * a, sign * b, -sign * d.x();
+  u.row(1) << b, sign + d.y() * d.y() * a, -d.y();
+  u.row(2) = d.transpose();
+  return u;
+}
+
+double angularSpan(std::vector<double> angles) {
+  if (angles.size() < 2) return 0.0;
+  std::sort(angles.begin(), angles.end());
+  double gap = angles.front() + 2.0 * kPi - angles.back();
+  for (std::size_t i = 1; i < angles.size(); ++i) gap = std::max(gap, angles[i] - angles[i - 1]);
+  return 2.0 * kPi - gap;
+}
+
+void checkOptions(ElementKind kind, const LeastSquaresOptions& o) {
+  if (o.max_iterations < 1)
+    fail("least-squares " + name(kind) + ": max_iterations is " +
+         std::to_string(o.max_iterations) + "; give at least 1 (default 100)");
+  if (!o.fixed_radius_mm) return;
+  if (kind != ElementKind::Circle2D && kind != ElementKind::Circle3D &&
+      kind != ElementKind::Sphere && kind != ElementKind::Cylinder)
+    fail("a known radius applies to circle, sphere and cylinder fits; a " + name(kind) +
+         " has no single radius: drop the known radius");
+  const double r = *o.fixed_radius_mm;
+  if (!std::isfinite(r) || !(r > 0.0))
+    fail("the known " + name(kind) + " radius must be a positive number of mm (got " + num(r) +
+         "): give the nominal radius, or fit without a known radius");
+}
+
+void checkCount(ElementKind kind, const Points3& pts) {
+  const int need = minimumPoints(kind);
+  if (static_cast<long>(pts.size()) < need) {
+    fail(name(kind) + " needs >= " + std::to_string(need) + " points; got " +
+         std::to_string(pts.size()) + ": probe at least " +
+         std::to_string(need - static_cast<long>(pts.size())) + " more points on the " +
+         name(kind));
+  }
+}
+
+namespace {
+
+// One pass: sums of d and d d^T, d = p - shift, two points per register, in blocks of
+// kBlock partial sums.
+template <bool Planar>
+Moments momentsAbout(const Points3& pts, const Vector3d& shift) {
+  const std::size_t n = pts.size();
+  const double* base = pts.front().data();
+  std::array<double, 9> t{};  // x y z xx xy xz yy yz zz
+  for (std::size_t b0 = 0; b0 < n; b0 += kBlock) {
+    const std::size_t b1 = std::min(n, b0 + kBlock);
+    Lanes sx = Lanes::Zero(), sy = sx, sz = sx, sxx = sx, sxy = sx, sxz = sx, syy = sx,
+          syz = sx, szz = sx;
+    std::size_t i = b0;
+    auto add = [&](auto x, auto y, auto z) {
+      sx += x, sy += y, sz += z;
+      sxx += x * x, sxy += x * y, sxz += x * z;
+      syy += y * y, syz += y * z, szz += z * z;
+    };
+    for (; i + 2 <= b1; i += 2) {
+      const Lanes x = gather<Lanes>(base, i, 3, 0) - shift.x();
+      const Lanes y = gather<Lanes>(base, i, 3, 1) - shift.y();
+      const Lanes z = Planar ? Lanes::Zero() : Lanes(gather<Lanes>(base, i, 3, 2) - shift.z());
+      add(x, y, z);
+    }
+    double tail[9] = {};
+    for (; i < b1; ++i) {
+      const double x = base[3 * i] - shift.x(), y = base[3 * i + 1] - shift.y();
+      const double z = Planar ? 0.0 : base[3 * i + 2] - shift.z();
+      const double v[9] = {x, y, z, x * x, x * y, x * z, y * y, y * z, z * z};
+      for (int k = 0; k < 9; ++k) tail[k] += v[k];
+    }
+    const Lanes* lanes[9] = {&sx, &sy, &sz, &sxx, &sxy, &sxz, &syy, &syz, &szz};
+    for (int k = 0; k < 9; ++k) t[k] += ((*lanes[k])(0) + (*lanes[k])(1)) + tail[k];
+  }
+  Moments m;
+  m.n = n;
+  const double inv = 1.0 / static_cast<double>(n);
+  const Vector3d mean(t[0] * inv, t[1] * inv, t[2] * inv);
+  m.centroid = shift + mean;
+  m.cov << t[3] * inv, t[4] * inv, t[5] * inv,  //
+      t[4] * inv, t[6] * inv, t[7] * inv,       //
+      t[5] * inv, t[7] * inv, t[8] * inv;
+  m.cov -= mean * mean.transpose();
+  return m;
+}
+
+[[noreturn]] void reportNonFinite(ElementKind kind, const Points3& pts, bool planar) {
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const Vector3d& p = pts[i];
+    const bool finite = planar ? p.head<2>().allFinite() : p.allFinite();
+    if (!finite)
+      fail(name(kind) + " point " + std::to_string(i + 1) + " is not finite (" + num(p.x()) +
+           ", " + num(p.y()) + (planar ? "" : ", " + num(p.z())) +
+           "): remove it or re-measure it");
+  }
+  fail(name(kind) + " point coordinates are too large to square in double precision: "
+       "check the units (mm expected)");
+}
+
+double maxDistanceFromPlane(const Points3& pts, const Vector3d& c, const Vector3d& n) {
+  double worst = 0.0;
+  for (const auto& p : pts) worst = std::max(worst, std::abs(n.dot(p - c)));
+  return worst;
+}
+
+[[noreturn]] void reportDuplicate(ElementKind kind, std::size_t a, std::size_t b) {
+  fail(name(kind) + " points " + std::to_string(std::min(a, b) + 1) + " and " +
+       std::to_string(std::max(a, b) + 1) + " coincide" + (isPlanar(kind) ? " in x, y" : "") +
+       ": remove the duplicate (a repeated point counts twice in the fit)");
+}
+
+// Sweep along one axis after sorting: the fallback for coordinates too large for the grid.
+void checkDuplicatesBySorting(ElementKind kind, const Points3& pts) {
+  const std::size_t n = pts.size();
+  const bool planar = isPlanar(kind);
+  std::vector<std::size_t> idx(n);
+  std::iota(idx.begin(), idx.end(), std::size_t{0});
+  std::sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) {
+    return pts[a].x() < pts[b].x() || (pts[a].x() == pts[b].x() && a < b);
+  });
+  for (std::size_t a = 0; a < n; ++a)
+    for (std::size_t b = a + 1; b < n; ++b) {
+      const Vector3d& p = pts[idx[a]];
+      const Vector3d& q = pts[idx[b]];
+      if (q.x() - p.x() > kCoincidentMm) break;
+      const double d = planar ? (p - q).head<2>().norm() : (p - q).norm();
+      if (d <= kCoincidentMm) reportDuplicate(kind, idx[a], idx[b]);
+    }
+}
+
+}  // namespace
+
+Moments computeMoments(ElementKind kind, const Points3& pts) {
+  const bool planar = isPlanar(kind);
+  auto run = [&](Vector3d shift) {
+    if (planar) shift.z() = 0.0;
+    return planar ? momentsAbout<true>(pts, shift) : momentsAbout<false>(pts, shift);
+  };
+  Moments m = run(pts.front());
+  if (!m.centroid.allFinite() || !m.cov.allFinite()) reportNonFinite(kind, pts, planar);
+  // A data point as the shift keeps the cancellation in E[dd^T] - E[d]E[d]^T small; only
+  // when that point lies far out from the rest is a second pass about the centroid needed.
+  if ((pts.front() - m.centroid).head(planar ? 2 : 3).squaredNorm() > 1e4 * m.cov.trace())
+    m = run(m.centroid);
+  return m;
+}
+
+Axes principalAxes(const Moments& m) {
+  Eigen::SelfAdjointEigenSolver<Matrix3d> es(m.cov);
+  return {es.eigenvalues().cwiseMax(0.0), es.eigenvectors()};
+}
+
+double rmsSize(const Moments& m) { return std::sqrt(std::max(m.cov.trace(), 0.0)); }
+
+double maxDistanceFromLine(const Points3& pts, const Vector3d& c, const Vector3d& d, bool planar) {
+  double worst = 0.0;
+  for (const auto& p : pts) {
+    Vector3d v = p - c;
+    if (planar) v.z() = 0.0;
+    worst = std::max(worst, (v - d * d.dot(v)).norm());
+  }
+  return worst;
+}
+
+// Points are hashed by their cell of a grid of kCell >> kCoincidentMm; two points within
+// kCoincidentMm share a cell unless one lies within kCoincidentMm of a cell face, and only
+// then are the neighbouring cells across that face looked at too (about 1 point in 300).
+// Open addressing with linear probing over a power-of-two table of 32-bit indices.
+void checkDuplicates(ElementKind kind, const Points3& pts) {
+  constexpr double kCell = 1e-6;  // mm
+  constexpr double kLimit = 4.0e18;  // |cell index| that still fits an int64 with room
+  const std::size_t n = pts.size();
+  const bool planar = isPlanar(kind);
+  const int dims = planar ? 2 : 3;
+  if (n > std::numeric_limits<std::uint32_t>::max() - 1) return checkDuplicatesBySorting(kind, pts);
+  std::vector<std::array<std::int64_t, 3>> cell(n);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double s = c < dims ? std::floor(pts[i](c) / kCell) : 0.0;
+      if (!(std::abs(s) < kLimit)) return checkDuplicatesBySorting(kind, pts);
+      cell[i][c] = static_cast<std::int64_t>(s);
+    }
+  std::size_t size = 16;
+  while (size < 2 * n) size *= 2;
+  const std::size_t mask = size - 1;
+  std::vector<std::uint32_t> table(size, 0);  // 0 empty, otherwise point index + 1
+  auto slot = [&](const std::array<std::int64_t, 3>& k) {
+    std::uint64_t h = static_cast<std::uint64_t>(k[0]) * 0x9E3779B97F4A7C15ULL;
+    h ^= static_cast<std::uint64_t>(k[1]) * 0xC2B2AE3D27D4EB4FULL;
+    h ^= static_cast<std::uint64_t>(k[2]) * 0x165667B19E3779F9ULL;
+    h ^= h >> 29;
+    return static_cast<std::size_t>(h) & mask;
+  };
+  auto near = [&](const Vector3d& p, const Vector3d& q) {
+    return (planar ? (p - q).head<2>().norm() : (p - q).norm()) <= kCoincidentMm;
+  };
+  auto lookIn = [&](std::size_t i, const std::array<std::int64_t, 3>& k) {
+    for (std::size_t s = slot(k);; s = (s + 1) & mask) {
+      const std::uint32_t e = table[s];
+      if (e == 0) return;
+      if (cell[e - 1] == k && near(pts[i], pts[e - 1])) reportDuplicate(kind, e - 1, i);
+    }
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    // Offsets to look at per axis: 0, and -1 / +1 next to a face.
+    std::array<std::array<int, 2>, 3> off{};
+    std::array<int, 3> count{1, 1, 1};
+    for (int c = 0; c < dims; ++c) {
+      const double x = pts[i](c);
+      const double lo = static_cast<double>(cell[i][c]) * kCell;
+      if (x - lo <= kCoincidentMm) off[c][count[c]++ - 1] = -1;
+      else if (lo + kCell - x <= kCoincidentMm) off[c][count[c]++ - 1] = 1;
+    }
+    for (int a = 0; a < count[0]; ++a)
+      for (int b = 0; b < count[1]; ++b)
+        for (int d = 0; d < count[2]; ++d) {
+          std::array<std::int64_t, 3> k = cell[i];
+          if (a > 0) k[0] += off[0][0];
+          if (b > 0) k[1] += off[1][0];
+          if (d > 0) k[2] += off[2][0];
+          lookIn(i, k);
+        }
+    std::size_t s = slot(cell[i]);
+    while (table[s] != 0) s = (s + 1) & mask;
+    table[s] = static_cast<std::uint32_t>(i + 1);
+  }
+}
+
+void checkNotCoincident(ElementKind kind, const Axes& ax, std::size_t n) {
+  if (std::sqrt(ax.value(2)) <= kCoincidentMm)
+    fail("all " + std::to_string(n) + " " + name(kind) + " points coincide" +
+         (isPlanar(kind) ? " in x, y" : "") + " (within " + num(kCoincidentMm) +
+         " mm): probe points spread over the " + name(kind));
+}
+
+void checkNotCollinear(ElementKind kind, const Points3& pts, const Moments& m, const Axes& ax,
+                       const std::string& need, const std::string& fix) {
+  if (std::sqrt(ax.value(1)) >= kRankTol * std::max(rmsSize(m), 1.0)) return;
+  const double dev = maxDistanceFromLine(pts, m.centroid, ax.vec.col(2), isPlanar(kind));
+  fail(name(kind) + " needs " + need + "; these " + std::to_string(pts.size()) + " lie within " +
+       um(dev) + " of a line: " + fix);
+}
+
+void checkNotCoplanar(ElementKind kind, const Points3& pts, const Moments& m, const Axes& ax,
+                      const std::string& need, const std::string& fix) {
+  if (std::sqrt(ax.value(0)) >= kRankTol * std::max(rmsSize(m), 1.0)) return;
+  const double dev = maxDistanceFromPlane(pts, m.centroid, ax.vec.col(0));
+  fail(name(kind) + " needs " + need + "; these " + std::to_string(pts.size()) + " lie within " +
+       um(dev) + " of a plane: " + fix);
+}
+
+void checkPlaneDetermined(ElementKind kind, const Points3& pts, const Moments& m, const Axes& ax) {
+  const std::size_t n = pts.size();
+  checkNotCoincident(kind, ax, n);
+  checkNotCollinear(kind, pts, m, ax, ">= 3 non-collinear points", "add a point off that line");
+  if (ax.value(1) - ax.value(0) <= 1e-12 * ax.value(2))
+    fail(name(kind) + ": the " + std::to_string(n) + " points spread equally in two directions "
+         "across a line, so no plane is preferred: probe points over a flat area");
+}
+
+// Plane local parameters: offset t along the normal n = e_min, tilts alpha, beta toward the
+// principal axes e_max, e_mid. J_i = [-1, e_max.q, e_mid.q] and, the axes being principal,
+// J^T J = diag(n, n var_max, n var_mid).
+Eigen::Vector3d planeLocalCovariance(const Axes& ax, std::size_t n) {
+  const double dn = static_cast<double>(n);
+  return {1.0 / dn, 1.0 / (dn * ax.value(2)), 1.0 / (dn * ax.value(1))};
+}
+
+Points3 strideSample(const Points3& pts, std::size_t count) {
+  Points3 sample;
+  sample.reserve(count);
+  for (std::size_t i = 0; i < count; ++i) sample.push_back(pts[i * pts.size() / count]);
+  return sample;
+}
+
+FitResult makeResult(const Element& e, const Points3& pts, int free_parameters,
+                     std::vector<std::string> names, const Eigen::MatrixXd& cov, int iterations,
+                     const LeastSquaresOptions& o, const ResidualStats* stats) {
+  if (!e.position_mm.allFinite() || !e.direction.allFinite() || !std::isfinite(e.radius_mm) ||
+      !std::isfinite(e.half_angle_rad))
+    fail("least-squares " + name(e.kind) + " fit produced no finite element: the points do not "
+         "determine a " + name(e.kind));
+  FitResult out;
+  out.element = e;
+  out.method = FitMethod::LeastSquares;
+  if (o.keep_residuals) {
+    fillResiduals(out, pts, free_parameters);
+  } else {
+    ResidualStats st;
+    if (stats) {
+      st = *stats;
+    } else {
+      st.min = std::numeric_limits<double>::infinity();
+      st.max = -st.min;
+      for (const auto& p : pts) {
+        const double d = signedDistance(e, p);
+        st.ssr += d * d;
+        st.min = std::min(st.min, d);
+        st.max = std::max(st.max, d);
+      }
+    }
+    const std::size_t n = pts.size();
+    out.ssr_mm2 = st.ssr;
+    out.rms_mm = std::sqrt(st.ssr / static_cast<double>(n));
+    out.form_mm = e.kind == ElementKind::Line3D ? 2.0 * st.max : st.max - st.min;
+    out.dof = static_cast<int>(n) - free_parameters;
+    out.residual_variance_mm2 = out.dof > 0 ? st.ssr / out.dof : 0.0;
+  }
+  out.parameter_names = std::move(names);
+  out.covariance_unscaled = cov;
+  out.iterations = iterations;
+  return out;
+}
+
+}  // namespace probeloop::geometry::ls

@@ -1,0 +1,476 @@
+// Internal to the least-squares fits (least_squares.hpp is the public contract): the shared
+// checks, the fused Gauss-Newton / Levenberg-Marquardt engine and the result assembly.
+// One translation unit per element family includes this header (ls_lines_planes.cpp,
+// ls_circle.cpp, ls_sphere.cpp, ls_axis.cpp), so the templates compile in parallel.
+//
+// The engine's pass over the points (why it is fast and still accurate):
+// - Each model gives one row per point: J_i = d r_i / d(local parameters) and r_i, the signed
+//   orthogonal distance, from a kernel written once for a scalar and for a pair of points
+//   in one SSE2 register (Lanes). One pass accumulates the upper triangle of [J r]^T [J r]
+//   (J^T J, J^T r and the sum of squares) and the residual range, in partial sums of
+//   kBlock rows (rounding grows like (B + n / B) eps instead of n eps).
+// - The step is solved from the Cholesky factor of J^T J (R = L^T, Q^T r = L^-1 J^T r).
+//   The fixed point J^T r = 0 does not depend on the solve; only the rate does. When the
+//   equilibrated J^T J is ill-conditioned (short arcs, small caps, partial cylinders) and the
+//   set is small enough (kDenseMax), the solution is polished by LM steps solved by
+//   Householder QR of [J r] itself, whose steps keep their digits (condition of J, not of
+//   J^T J), and the covariance comes from that R.
+// - The pass that accepts the final state also carries the statistics the result needs
+//   (sum of squares, residual range), so a fit that stores no residuals reads the points
+//   once per iteration and never again.
+#pragma once
+
+#include <Eigen/Cholesky>
+#include <Eigen/Dense>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "geometry/least_squares.hpp"
+
+namespace probeloop::geometry::ls {
+
+using Eigen::Matrix3d;
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+template <int P>
+using Vec = Eigen::Matrix<double, P, 1>;
+template <int P>
+using Mat = Eigen::Matrix<double, P, P>;
+using Points2 = std::vector<Vector2d>;
+
+constexpr double kPi = std::numbers::pi;
+
+// Points closer than this are the same point (mm).
+constexpr double kCoincidentMm = 1e-9;
+// Points count as collinear (coplanar) when their RMS distance from the best line (plane)
+// is below kRankTol * max(RMS size, 1 mm): beyond that the orientation is lost to rounding.
+constexpr double kRankTol = 1e-7;
+// Sets up to this size may be polished with QR on the full n x p Jacobian.
+constexpr std::size_t kDenseMax = 4096;
+// Condition number of the equilibrated J^T J beyond which a small set is polished by QR:
+// the normal-equation step then keeps fewer than 16 - log10(1e6) = 10 digits.
+constexpr double kPolishCondition = 1e6;
+// Rows per partial sum: rounding of the sums grows like (B + n / B) eps instead of n eps.
+constexpr std::size_t kBlock = 1024;
+// Points used to compare the starts of cylinder and cone fits, and to bring a start close
+// (coarse stage) before the full set is iterated on.
+constexpr std::size_t kStartSample = 2000;
+// Sets above this size first converge on a subsample of kStartSample points.
+constexpr std::size_t kCoarseMin = 16 * kStartSample;
+// Convergence: dimensionless step (mm / data size, rad), relative gradient |Q^T r| / |r|.
+constexpr double kStepTol = 1e-12;
+constexpr double kGradTol = 1e-12;
+// Rounding allowance of a sum of squares when comparing two of them.
+constexpr double kSsrSlack = 1e-13;
+// Largest condition number of the column-equilibrated J^T J at the solution; beyond it a
+// parameter (typically the radius of a short arc or small cap) is not determined.
+constexpr double kMaxCondition = 1e14;
+// A cone with a smaller half angle is a cylinder (its direction sign is undefined).
+constexpr double kMinHalfAngle = 1e-7;
+
+// ---------------------------------------------------------------------------------------
+// Messages and small geometry (ls_checks.cpp)
+
+std::string num(double v, int digits = 3);
+std::string um(double mm);
+std::string degrees(double rad);
+std::string name(ElementKind k);
+[[noreturn]] void fail(const std::string& message);
+bool isPlanar(ElementKind k);
+// Unit vector with its largest-magnitude component positive (elements.hpp).
+Vector3d canonical(const Vector3d& d);
+// Rows e1, e2, e3 = d of a rotation.
+Matrix3d frameOf(const Vector3d& d);
+// Angle covered by 2D directions seen from the origin: 2 pi minus the largest gap.
+double angularSpan(std::vector<double> angles);
+
+// ---------------------------------------------------------------------------------------
+// Input checks and moments (ls_checks.cpp)
+
+void checkOptions(ElementKind kind, const LeastSquaresOptions& o);
+void checkCount(ElementKind kind, const Points3& pts);
+
+struct Moments {
+  std::size_t n = 0;
+  Vector3d centroid = Vector3d::Zero();
+  Matrix3d cov = Matrix3d::Zero();  // mean of (p - c)(p - c)^T
+};
+Moments computeMoments(ElementKind kind, const Points3& pts);
+
+struct Axes {
+  Vector3d value;  // variances along the principal axes, ascending, clamped at 0
+  Matrix3d vec;    // columns: unit principal axes
+};
+Axes principalAxes(const Moments& m);
+
+// RMS distance of the points from their centroid.
+double rmsSize(const Moments& m);
+double maxDistanceFromLine(const Points3& pts, const Vector3d& c, const Vector3d& d, bool planar);
+// Throws when two points lie within kCoincidentMm (in x, y for the planar kinds). Expected
+// O(n): points are hashed by their cell of a 1 nm grid (neighbour cells are looked at only
+// for a point within kCoincidentMm of a cell face).
+void checkDuplicates(ElementKind kind, const Points3& pts);
+void checkNotCoincident(ElementKind kind, const Axes& ax, std::size_t n);
+void checkNotCollinear(ElementKind kind, const Points3& pts, const Moments& m, const Axes& ax,
+                       const std::string& need, const std::string& fix);
+void checkNotCoplanar(ElementKind kind, const Points3& pts, const Moments& m, const Axes& ax,
+                      const std::string& need, const std::string& fix);
+// Checks shared by the plane and the circle's plane.
+void checkPlaneDetermined(ElementKind kind, const Points3& pts, const Moments& m, const Axes& ax);
+// Local covariance (offset, two tilts) of the LS plane through principal axes.
+Eigen::Vector3d planeLocalCovariance(const Axes& ax, std::size_t n);
+
+// Residual statistics of a fit whose final pass already gave them.
+struct ResidualStats {
+  double ssr = 0.0;
+  double min = 0.0;
+  double max = 0.0;
+};
+
+// The result: residuals from signedDistance (options.keep_residuals) or the statistics of
+// the fit's final pass (stats; one pass over the points when absent).
+FitResult makeResult(const Element& e, const Points3& pts, int free_parameters,
+                     std::vector<std::string> names, const Eigen::MatrixXd& cov, int iterations,
+                     const LeastSquaresOptions& o, const ResidualStats* stats = nullptr);
+
+// Centre for a known radius R: points of mean squared distance s2 from their centroid m
+// put it at sqrt(R^2 - s2) from m (sum |p - c|^2 = n s2 + n |m - c|^2 on an exact circle);
+// the side is taken from the free-radius start.
+template <class V>
+V knownRadiusCentre(const V& mean, double s2, const V& free_centre, double radius, const V& side) {
+  V u = free_centre - mean;
+  if (!(u.norm() > 0.0)) u = side;
+  return mean + u.normalized() * std::sqrt(std::max(radius * radius - s2, 0.0));
+}
+
+// ---------------------------------------------------------------------------------------
+// Row kernels: scalar or two points at once
+
+// Two points in the two lanes of one SSE2 register. Every operation is IEEE per lane, so
+// the sums do not depend on the instruction set the compiler picks.
+using Lanes = Eigen::Array2d;
+template <class T>
+constexpr std::size_t kWidth = std::is_same_v<T, Lanes> ? 2 : 1;
+
+inline double sqrtOf(double x) { return std::sqrt(x); }
+inline Lanes sqrtOf(const Lanes& x) { return x.sqrt(); }
+inline double atLeast(double x, double floor) { return std::max(x, floor); }
+inline Lanes atLeast(const Lanes& x, double floor) { return x.max(floor); }
+inline double reciprocal(double x) { return 1.0 / x; }
+inline Lanes reciprocal(const Lanes& x) { return x.inverse(); }
+template <class T>
+inline T constant(double x) {
+  if constexpr (std::is_same_v<T, Lanes>)
+    return Lanes::Constant(x);
+  else
+    return x;
+}
+
+// Coordinate c of point i (and i + 1) of points stored as `stride` doubles each.
+template <class T>
+inline T gather(const double* base, std::size_t i, std::size_t stride, int c) {
+  if constexpr (std::is_same_v<T, Lanes>)
+    return Lanes(base[i * stride + c], base[(i + 1) * stride + c]);
+  else
+    return base[i * stride + c];
+}
+
+// ---------------------------------------------------------------------------------------
+// Reduced least-squares problem
+
+template <int P>
+struct Linearisation {
+  Mat<P> R = Mat<P>::Zero();    // J = Q R (or R^T R = J^T J), upper triangular
+  Vec<P> qtr = Vec<P>::Zero();  // Q^T r (R^-T J^T r)
+  double ssr = 0.0;
+  double rmin = 0.0, rmax = 0.0;  // residual range
+  bool ok = false;
+  bool dense = false;  // R from QR of J itself
+};
+
+// Upper triangle of [J r]^T [J r] in row-major order, and the residual range.
+template <int P>
+struct NormalSums {
+  static constexpr int K = (P + 1) * (P + 2) / 2;
+  std::array<double, K> s{};
+  double rmin = std::numeric_limits<double>::infinity();
+  double rmax = -std::numeric_limits<double>::infinity();
+};
+
+template <int P, class T>
+inline void addProducts(std::array<T, NormalSums<P>::K>& acc, const std::array<T, P + 1>& v) {
+  int k = 0;
+#pragma GCC unroll 8
+  for (int a = 0; a <= P; ++a) {
+#pragma GCC unroll 8
+    for (int b = a; b <= P; ++b) acc[k++] += v[a] * v[b];
+  }
+}
+
+// One pass: the model's rows at state s, summed in blocks.
+template <class Model>
+NormalSums<Model::P> accumulate(const Model& model, const typename Model::State& s) {
+  constexpr int P = Model::P;
+  constexpr int K = NormalSums<P>::K;
+  const auto pre = model.prepare(s);
+  const std::size_t n = model.count();
+  NormalSums<P> out;
+  Lanes lo = Lanes::Constant(std::numeric_limits<double>::infinity());
+  Lanes hi = -lo;
+  for (std::size_t b0 = 0; b0 < n; b0 += kBlock) {
+    const std::size_t b1 = std::min(n, b0 + kBlock);
+    std::array<Lanes, K> acc;
+    acc.fill(Lanes::Zero());
+    std::size_t i = b0;
+    for (; i + 2 <= b1; i += 2) {
+      std::array<Lanes, P + 1> v;
+      model.template row<Lanes>(pre, i, v);
+      addProducts<P>(acc, v);
+      lo = lo.min(v[P]);
+      hi = hi.max(v[P]);
+    }
+    std::array<double, K> tail{};
+    for (; i < b1; ++i) {
+      std::array<double, P + 1> v;
+      model.template row<double>(pre, i, v);
+      addProducts<P>(tail, v);
+      out.rmin = std::min(out.rmin, v[P]);
+      out.rmax = std::max(out.rmax, v[P]);
+    }
+    for (int k = 0; k < K; ++k) out.s[k] += (acc[k](0) + acc[k](1)) + tail[k];
+  }
+  out.rmin = std::min({out.rmin, lo(0), lo(1)});
+  out.rmax = std::max({out.rmax, hi(0), hi(1)});
+  return out;
+}
+
+// Cholesky of the accumulated J^T J.
+template <int P>
+Linearisation<P> fromNormalSums(const NormalSums<P>& sums) {
+  Mat<P + 1> t = Mat<P + 1>::Zero();
+  int k = 0;
+  for (int a = 0; a <= P; ++a)
+    for (int b = a; b <= P; ++b) t(a, b) = sums.s[k++];
+  Linearisation<P> out;
+  out.rmin = sums.rmin;
+  out.rmax = sums.rmax;
+  const Mat<P> jtj = t.template topLeftCorner<P, P>().template selfadjointView<Eigen::Upper>();
+  Eigen::LLT<Mat<P>> llt(jtj);
+  if (llt.info() != Eigen::Success) return out;
+  out.R = llt.matrixU();
+  out.qtr = llt.matrixL().solve(Vec<P>(t.col(P).template head<P>()));
+  out.ssr = t(P, P);
+  out.ok = out.R.allFinite() && out.qtr.allFinite() && std::isfinite(out.ssr) &&
+           (out.R.diagonal().array() != 0.0).all();
+  return out;
+}
+
+// Householder QR of the full [J r] (blocked sum of squares kept for comparability).
+template <class Model>
+Linearisation<Model::P> denseLinearisation(const Model& model, const typename Model::State& s) {
+  constexpr int P = Model::P;
+  const auto pre = model.prepare(s);
+  const std::size_t n = model.count();
+  // At least P + 1 rows so that the R factor of [J r] is square; extra rows are zero.
+  Eigen::Matrix<double, Eigen::Dynamic, P + 1> a =
+      Eigen::Matrix<double, Eigen::Dynamic, P + 1>::Zero(
+          static_cast<Eigen::Index>(std::max<std::size_t>(n, P + 1)), P + 1);
+  Linearisation<P> out;
+  out.rmin = std::numeric_limits<double>::infinity();
+  out.rmax = -out.rmin;
+  double block = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    std::array<double, P + 1> v;
+    model.template row<double>(pre, i, v);
+    for (int c = 0; c <= P; ++c) a(static_cast<Eigen::Index>(i), c) = v[c];
+    block += v[P] * v[P];
+    out.rmin = std::min(out.rmin, v[P]);
+    out.rmax = std::max(out.rmax, v[P]);
+    if ((i + 1) % kBlock == 0 || i + 1 == n) out.ssr += block, block = 0.0;
+  }
+  Eigen::HouseholderQR<Eigen::Matrix<double, Eigen::Dynamic, P + 1>> qr(a);
+  const Mat<P + 1> ra =
+      qr.matrixQR().template topRows<P + 1>().template triangularView<Eigen::Upper>();
+  out.R = ra.template topLeftCorner<P, P>();
+  out.qtr = ra.col(P).template head<P>();
+  out.dense = true;
+  out.ok = out.R.allFinite() && out.qtr.allFinite() && std::isfinite(out.ssr) &&
+           (out.R.diagonal().array() != 0.0).all();
+  return out;
+}
+
+template <class Model>
+Linearisation<Model::P> linearise(const Model& model, const typename Model::State& s, bool dense) {
+  if (!dense) {
+    Linearisation<Model::P> l = fromNormalSums<Model::P>(accumulate(model, s));
+    if (l.ok) return l;
+    // J^T J lost definiteness to rounding: the full Jacobian still may have full rank.
+  }
+  return denseLinearisation(model, s);
+}
+
+template <int P>
+Vec<P> columnNorms(const Mat<P>& r) {
+  return r.colwise().norm().transpose();
+}
+
+// argmin |R d + qtr|^2 + lambda |D d|^2, by QR of the small stacked matrix [R; sqrt(lambda) D]
+// (MINPACK's lmpar/qrsolv idea, More 1978).
+template <int P>
+Vec<P> dampedStep(const Linearisation<P>& l, const Vec<P>& d, double lambda) {
+  if (lambda == 0.0) return -l.R.template triangularView<Eigen::Upper>().solve(l.qtr);
+  Eigen::Matrix<double, 2 * P, P> a;
+  a.template topRows<P>() = l.R;
+  a.template bottomRows<P>() = (std::sqrt(lambda) * d).asDiagonal();
+  Vec<2 * P> b = Vec<2 * P>::Zero();
+  b.template head<P>() = -l.qtr;
+  return a.householderQr().solve(b);
+}
+
+template <class Model>
+struct LmRun {
+  typename Model::State state{};
+  Linearisation<Model::P> lin;
+  int iterations = 0;
+  bool converged = false;
+};
+
+// Levenberg-Marquardt from `start`: one pass over the points per trial state (the pass that
+// accepts a state is its linearisation for the next step).
+template <class Model>
+LmRun<Model> levenbergMarquardt(const Model& model, const typename Model::State& start,
+                                int max_iterations, bool dense = false) {
+  constexpr int P = Model::P;
+  LmRun<Model> run;
+  run.state = start;
+  if (!model.valid(start)) return run;
+  run.lin = linearise(model, start, dense);
+  if (!run.lin.ok) return run;
+  Vec<P> scale = columnNorms(run.lin.R).cwiseMax(1e-300);
+  double lambda = 0.0;
+  double previous_size = std::numeric_limits<double>::infinity();
+  while (run.iterations < max_iterations) {
+    ++run.iterations;
+    if (run.lin.qtr.norm() <= kGradTol * std::sqrt(run.lin.ssr)) {
+      run.converged = true;  // residuals orthogonal to the columns of J: stationary
+      break;
+    }
+    bool accepted = false;
+    for (int tries = 0; tries < 60 && !accepted && !run.converged; ++tries) {
+      const Vec<P> step = dampedStep(run.lin, scale, lambda);
+      const double size =
+          step.allFinite() ? model.stepSize(step) : std::numeric_limits<double>::infinity();
+      if (std::isfinite(size)) {
+        const typename Model::State next = model.apply(run.state, step);
+        if (model.valid(next)) {
+          const Linearisation<P> l = linearise(model, next, dense);
+          // Ties within the rounding of the sum of squares are accepted: close to the
+          // solution a Gauss-Newton step changes the sum by less than its rounding error
+          // and still moves the parameters by a meaningful amount. Each residual carries
+          // a rounding error of about model.rounding (eps times the coordinates), so the
+          // sum carries about 2 |r| sqrt(n) model.rounding.
+          const double slack = kSsrSlack * run.lin.ssr +
+                               2.0 * model.rounding *
+                                   std::sqrt(static_cast<double>(model.count()) * run.lin.ssr);
+          if (l.ok && l.ssr <= run.lin.ssr + slack) {
+            const bool gauss_newton = lambda == 0.0;
+            const bool insignificant = run.lin.ssr - l.ssr <= slack;
+            run.state = next;
+            run.lin = l;
+            scale = scale.cwiseMax(columnNorms(l.R));
+            lambda = lambda < 1e-8 ? 0.0 : 0.1 * lambda;
+            accepted = true;
+            // Converged when the step is negligible, or when Gauss-Newton steps no longer
+            // shrink while the sum of squares no longer changes: the rounding floor.
+            if (size <= kStepTol || (gauss_newton && insignificant && size > 0.5 * previous_size))
+              run.converged = true;
+            previous_size = gauss_newton ? size : std::numeric_limits<double>::infinity();
+            break;
+          }
+        }
+      }
+      if (size <= kStepTol) run.converged = true;  // not even a rounding-size step helps
+      lambda = lambda == 0.0 ? 1e-3 : 10.0 * lambda;
+    }
+    if (run.converged || !accepted) break;
+  }
+  return run;
+}
+
+// Condition number of the column-equilibrated J^T J and its most ill-determined
+// parameter combination (right singular vector, equilibrated units).
+template <int P>
+struct Conditioning {
+  double condition = std::numeric_limits<double>::infinity();
+  Vec<P> weakest = Vec<P>::Zero();
+};
+
+template <int P>
+Conditioning<P> conditioning(const Linearisation<P>& l) {
+  Conditioning<P> c;
+  if (!l.ok) return c;
+  const Vec<P> norms = columnNorms(l.R);
+  if ((norms.array() <= 0.0).any()) return c;
+  const Eigen::MatrixXd scaled = l.R * norms.cwiseInverse().asDiagonal();
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(scaled, Eigen::ComputeFullV);
+  const double smax = svd.singularValues()(0);
+  const double smin = svd.singularValues()(P - 1);
+  c.condition = smin > 0.0 ? (smax / smin) * (smax / smin) : std::numeric_limits<double>::infinity();
+  c.weakest = svd.matrixV().col(P - 1);
+  return c;
+}
+
+// A converged run whose normal equations are ill-conditioned, on a set small enough for it,
+// polished with QR-solved steps from where it stopped (the result of a dense run is kept
+// only when it converged too).
+template <class Model>
+LmRun<Model> polished(const Model& model, LmRun<Model> run, int max_iterations) {
+  if (run.lin.dense || !run.lin.ok || model.count() > kDenseMax) return run;
+  if (conditioning(run.lin).condition <= kPolishCondition) return run;
+  LmRun<Model> dense = levenbergMarquardt(model, run.state, max_iterations, true);
+  if (!dense.lin.ok) return run;
+  dense.iterations += run.iterations;
+  dense.converged = dense.converged && run.converged;
+  return dense;
+}
+
+// (J^T J)^-1 = R^-1 R^-T.
+template <int P>
+Mat<P> inverseNormal(const Linearisation<P>& l) {
+  const Mat<P> rinv = l.R.template triangularView<Eigen::Upper>().solve(Mat<P>::Identity());
+  return rinv * rinv.transpose();
+}
+
+template <int P>
+ResidualStats statsOf(const Linearisation<P>& l) {
+  return {l.ssr, l.rmin, l.rmax};
+}
+
+// Every kStartSample-th part of a large set, evenly spread over its order.
+Points3 strideSample(const Points3& pts, std::size_t count);
+
+// ---------------------------------------------------------------------------------------
+// The element families (one translation unit each)
+
+FitResult fitLine2D(const Points3& pts, const Moments& m, const LeastSquaresOptions& o);
+FitResult fitLine3D(const Points3& pts, const Moments& m, const Axes& ax,
+                    const LeastSquaresOptions& o);
+FitResult fitPlane(const Points3& pts, const Moments& m, const Axes& ax,
+                   const LeastSquaresOptions& o);
+FitResult fitCircle2D(const Points3& pts, const Moments& m, const LeastSquaresOptions& o);
+FitResult fitCircle3D(const Points3& pts, const Moments& m, const Axes& ax,
+                      const LeastSquaresOptions& o);
+FitResult fitSphereLs(const Points3& pts, const Moments& m, const Axes& ax,
+                      const LeastSquaresOptions& o);
+FitResult fitCylinder(const Points3& pts, const Moments& m, const Axes& ax,
+                      const LeastSquaresOptions& o);
+FitResult fitCone(const Points3& pts, const Moments& m, const Axes& ax,
+                  const LeastSquaresOptions& o);
+
+}  // namespace probeloop::geometry::ls
