@@ -200,64 +200,64 @@ double maxDistanceFromLine(const Points3& pts, const Vector3d& c, const Vector3d
 // Points are hashed by their cell of a grid of kCell >> kCoincidentMm; two points within
 // kCoincidentMm share a cell unless one lies within kCoincidentMm of a cell face, and only
 // then are the neighbouring cells across that face looked at too (about 1 point in 300).
-// Open addressing with linear probing over a power-of-two table of 32-bit indices.
+// Open addressing with linear probing over a power-of-two table; an entry holds the cell's
+// 64-bit hash and the point's index, and a hit is confirmed by the distance itself.
 void checkDuplicates(ElementKind kind, const Points3& pts) {
-  constexpr double kCell = 1e-6;  // mm
+  constexpr double kPerMm = 1e6;     // cells per mm: 1 nm cells
   constexpr double kLimit = 4.0e18;  // |cell index| that still fits an int64 with room
   const std::size_t n = pts.size();
   const bool planar = isPlanar(kind);
   const int dims = planar ? 2 : 3;
-  if (n > std::numeric_limits<std::uint32_t>::max() - 1) return checkDuplicatesBySorting(kind, pts);
-  std::vector<std::array<std::int64_t, 3>> cell(n);
-  for (std::size_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c) {
-      const double s = c < dims ? std::floor(pts[i](c) / kCell) : 0.0;
-      if (!(std::abs(s) < kLimit)) return checkDuplicatesBySorting(kind, pts);
-      cell[i][c] = static_cast<std::int64_t>(s);
-    }
+  if (n >= std::numeric_limits<std::uint32_t>::max()) return checkDuplicatesBySorting(kind, pts);
   std::size_t size = 16;
   while (size < 2 * n) size *= 2;
   const std::size_t mask = size - 1;
-  std::vector<std::uint32_t> table(size, 0);  // 0 empty, otherwise point index + 1
-  auto slot = [&](const std::array<std::int64_t, 3>& k) {
-    std::uint64_t h = static_cast<std::uint64_t>(k[0]) * 0x9E3779B97F4A7C15ULL;
-    h ^= static_cast<std::uint64_t>(k[1]) * 0xC2B2AE3D27D4EB4FULL;
-    h ^= static_cast<std::uint64_t>(k[2]) * 0x165667B19E3779F9ULL;
-    h ^= h >> 29;
-    return static_cast<std::size_t>(h) & mask;
+  struct Entry {
+    std::uint64_t key;
+    std::uint32_t index;  // point index + 1; 0 marks an empty slot
   };
-  auto near = [&](const Vector3d& p, const Vector3d& q) {
-    return (planar ? (p - q).head<2>().norm() : (p - q).norm()) <= kCoincidentMm;
+  std::vector<Entry> table(size, Entry{0, 0});
+  auto keyOf = [](std::int64_t a, std::int64_t b, std::int64_t c) {
+    std::uint64_t h = static_cast<std::uint64_t>(a) * 0x9E3779B97F4A7C15ULL;
+    h ^= static_cast<std::uint64_t>(b) * 0xC2B2AE3D27D4EB4FULL;
+    h ^= static_cast<std::uint64_t>(c) * 0x165667B19E3779F9ULL;
+    return h ^ (h >> 29);
   };
-  auto lookIn = [&](std::size_t i, const std::array<std::int64_t, 3>& k) {
-    for (std::size_t s = slot(k);; s = (s + 1) & mask) {
-      const std::uint32_t e = table[s];
-      if (e == 0) return;
-      if (cell[e - 1] == k && near(pts[i], pts[e - 1])) reportDuplicate(kind, e - 1, i);
+  auto lookIn = [&](std::size_t i, std::uint64_t key) {
+    for (std::size_t s = key & mask;; s = (s + 1) & mask) {
+      const Entry& e = table[s];
+      if (e.index == 0) return;
+      if (e.key != key) continue;
+      const Vector3d d = pts[i] - pts[e.index - 1];
+      if ((planar ? d.head<2>().norm() : d.norm()) <= kCoincidentMm)
+        reportDuplicate(kind, e.index - 1, i);
     }
   };
   for (std::size_t i = 0; i < n; ++i) {
-    // Offsets to look at per axis: 0, and -1 / +1 next to a face.
-    std::array<std::array<int, 2>, 3> off{};
-    std::array<int, 3> count{1, 1, 1};
+    std::int64_t cell[3] = {0, 0, 0};
+    int side[3] = {0, 0, 0};  // -1 / +1: within kCoincidentMm of the lower / upper face
     for (int c = 0; c < dims; ++c) {
-      const double x = pts[i](c);
-      const double lo = static_cast<double>(cell[i][c]) * kCell;
-      if (x - lo <= kCoincidentMm) off[c][count[c]++ - 1] = -1;
-      else if (lo + kCell - x <= kCoincidentMm) off[c][count[c]++ - 1] = 1;
+      const double v = pts[i](c) * kPerMm;
+      if (!(std::abs(v) < kLimit)) return checkDuplicatesBySorting(kind, pts);
+      std::int64_t k = static_cast<std::int64_t>(v);
+      if (v < static_cast<double>(k)) --k;  // floor without a libm call
+      cell[c] = k;
+      const double frac = (v - static_cast<double>(k)) / kPerMm;  // mm above the lower face
+      if (frac <= kCoincidentMm) side[c] = -1;
+      else if (1.0 / kPerMm - frac <= kCoincidentMm) side[c] = 1;
     }
-    for (int a = 0; a < count[0]; ++a)
-      for (int b = 0; b < count[1]; ++b)
-        for (int d = 0; d < count[2]; ++d) {
-          std::array<std::int64_t, 3> k = cell[i];
-          if (a > 0) k[0] += off[0][0];
-          if (b > 0) k[1] += off[1][0];
-          if (d > 0) k[2] += off[2][0];
-          lookIn(i, k);
-        }
-    std::size_t s = slot(cell[i]);
-    while (table[s] != 0) s = (s + 1) & mask;
-    table[s] = static_cast<std::uint32_t>(i + 1);
+    const std::uint64_t own = keyOf(cell[0], cell[1], cell[2]);
+    if (side[0] == 0 && side[1] == 0 && side[2] == 0) {
+      lookIn(i, own);
+    } else {
+      for (int a = 0; a <= (side[0] != 0); ++a)
+        for (int b = 0; b <= (side[1] != 0); ++b)
+          for (int d = 0; d <= (side[2] != 0); ++d)
+            lookIn(i, keyOf(cell[0] + a * side[0], cell[1] + b * side[1], cell[2] + d * side[2]));
+    }
+    std::size_t s = own & mask;
+    while (table[s].index != 0) s = (s + 1) & mask;
+    table[s] = Entry{own, static_cast<std::uint32_t>(i + 1)};
   }
 }
 

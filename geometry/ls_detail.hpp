@@ -66,6 +66,8 @@ constexpr std::size_t kCoarseMin = 16 * kStartSample;
 // Convergence: dimensionless step (mm / data size, rad), relative gradient |Q^T r| / |r|.
 constexpr double kStepTol = 1e-12;
 constexpr double kGradTol = 1e-12;
+// Largest step for the contraction estimate to be trusted (asymptotic regime).
+constexpr double kContractedStep = 1e-6;
 // Rounding allowance of a sum of squares when comparing two of them.
 constexpr double kSsrSlack = 1e-13;
 // Largest condition number of the column-equilibrated J^T J at the solution; beyond it a
@@ -366,6 +368,24 @@ LmRun<Model> levenbergMarquardt(const Model& model, const typename Model::State&
       const Vec<P> step = dampedStep(run.lin, scale, lambda);
       const double size =
           step.allFinite() ? model.stepSize(step) : std::numeric_limits<double>::infinity();
+      // On a large set (a scan) the last Gauss-Newton step is taken without another pass
+      // over the points when it is negligible (<= kStepTol), or when the iteration
+      // contracts by theta = size / previous size per step and the solution is then about
+      // theta * size <= kStepTol away (Deuflhard's a-posteriori estimate). The sum of
+      // squares moves by the step's predicted decrease |Q^T r|^2; the residual range by at
+      // most the step (size times the data size: below a picometre whenever this fires).
+      // Small sets, where a pass costs little, verify every step instead.
+      if (lambda == 0.0 && model.count() > kDenseMax &&
+          (size <= kStepTol || (size <= kContractedStep && std::isfinite(previous_size) &&
+                                size * (size / previous_size) <= kStepTol))) {
+        const typename Model::State next = model.apply(run.state, step);
+        if (model.valid(next)) {
+          run.state = next;
+          run.lin.ssr = std::max(run.lin.ssr - run.lin.qtr.squaredNorm(), 0.0);
+          run.converged = true;
+          break;
+        }
+      }
       if (std::isfinite(size)) {
         const typename Model::State next = model.apply(run.state, step);
         if (model.valid(next)) {
@@ -417,12 +437,15 @@ Conditioning<P> conditioning(const Linearisation<P>& l) {
   if (!l.ok) return c;
   const Vec<P> norms = columnNorms(l.R);
   if ((norms.array() <= 0.0).any()) return c;
-  const Eigen::MatrixXd scaled = l.R * norms.cwiseInverse().asDiagonal();
-  Eigen::JacobiSVD<Eigen::MatrixXd> svd(scaled, Eigen::ComputeFullV);
-  const double smax = svd.singularValues()(0);
-  const double smin = svd.singularValues()(P - 1);
-  c.condition = smin > 0.0 ? (smax / smin) * (smax / smin) : std::numeric_limits<double>::infinity();
-  c.weakest = svd.matrixV().col(P - 1);
+  // Eigenvalues of the equilibrated J^T J = S^T S, S = R D^-1 (the squared singular values
+  // of S; the smallest carries an error of about eps times the largest, ample for a
+  // threshold of 1e14).
+  const Mat<P> scaled = l.R * norms.cwiseInverse().asDiagonal();
+  Eigen::SelfAdjointEigenSolver<Mat<P>> es(scaled.transpose() * scaled);
+  const double lmax = es.eigenvalues()(P - 1);
+  const double lmin = es.eigenvalues()(0);
+  c.condition = lmin > 0.0 ? lmax / lmin : std::numeric_limits<double>::infinity();
+  c.weakest = es.eigenvectors().col(0);
   return c;
 }
 
