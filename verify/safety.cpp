@@ -590,26 +590,25 @@ class Checker : public gcode::MachineInterface {
       if (cutting) removeMaterial(tool, mo);
     }
     if ((rotary || tilt) && !cutting && low < plane - 1e-3) {
-      const double top = scene_.top();
-      const double r_tool = tool.radiusBelow(top - std::min(mo.a.z(), mo.b.z()));
+      const double r_tool = tool.radiusBelow(plane - std::min(mo.a.z(), mo.b.z()));
       const double rho = std::min((mo.a.head<2>() - m_.c_axis_centre_mm).norm(), (mo.b.head<2>() - m_.c_axis_centre_mm).norm());
-      const double env = envelope(low);
+      const double env = envelope();
       if (tilt || rho - r_tool < env)
         add("rotary-below-clearance",
             std::string(tilt ? "B" : "C") + " moves from " + fmt(tilt ? pos_.b_deg : pos_.c_deg) + " to " +
                 fmt(tilt ? to.b_deg : to.c_deg) + " deg with the " + (tool.probe ? "probe" : "tool") + "'s lowest point at Z " +
-                fmt(low) + (tilt ? "" : ", " + fmt(rho - r_tool) + " mm from the C axis, inside the " + fmt(env) + " mm the turning part sweeps"),
+                fmt(low) + (tilt ? "" : ", " + fmt(rho - r_tool) + " mm from the C axis, inside the " + fmt(env) + " mm circle the table's bodies sweep"),
             mo.a, "clearance plane Z " + fmt(plane) + " (" + fmt(scene_.clearance) + " mm above the highest body)");
     }
     pos_ = to;
   }
 
-  double envelope(double z) const {
-    double env = scene_.material.envelope(m_.c_axis_centre_mm, z);
-    for (const auto& s : scene_.spheres)
-      if (s.c.z() + s.r > z) env = std::max(env, (s.c.head<2>() - m_.c_axis_centre_mm).norm() + s.r);
-    for (const auto& c : scene_.cyls)
-      if (c.z1 > z) env = std::max(env, (c.c - m_.c_axis_centre_mm).norm() + c.r);
+  // The circle every body on the table sweeps when C turns (whatever its height: below the
+  // clearance plane the margin is the plane's, not the bodies' tops).
+  double envelope() const {
+    double env = scene_.material.envelope(m_.c_axis_centre_mm, -kInf);
+    for (const auto& s : scene_.spheres) env = std::max(env, (s.c.head<2>() - m_.c_axis_centre_mm).norm() + s.r);
+    for (const auto& c : scene_.cyls) env = std::max(env, (c.c - m_.c_axis_centre_mm).norm() + c.r);
     return env;
   }
 
