@@ -258,6 +258,7 @@ class Checker : public gcode::MachineInterface {
     replay_ = false;
     outcomes_.clear();
     probe_lines_.clear();
+    probe_tips_.clear();
   }
   void whatIf(std::size_t flip) {
     replay_ = true;
@@ -268,6 +269,7 @@ class Checker : public gcode::MachineInterface {
   bool flipped() const { return flipped_; }
   const std::vector<int>& probeLines() const { return probe_lines_; }
   const std::vector<gcode::ProbeOutcome>& outcomes() const { return outcomes_; }
+  const std::vector<Vector3d>& probeTips() const { return probe_tips_; }
 
   // --- MachineInterface ---
   gcode::MachinePosition start() const override { return pos_; }
@@ -295,6 +297,7 @@ class Checker : public gcode::MachineInterface {
     const auto r = probeNominal(to);
     outcomes_.push_back(r);
     probe_lines_.push_back(line_);
+    probe_tips_.push_back(tip(r.stop));
     pos_ = r.stop;
     return r;
   }
@@ -344,6 +347,9 @@ class Checker : public gcode::MachineInterface {
   std::size_t flip_ = 0, count_ = 0;
   std::vector<gcode::ProbeOutcome> outcomes_;
   std::vector<int> probe_lines_;
+  std::vector<Vector3d> probe_tips_;  // where each probe move stopped (tip, machine coordinates)
+  mutable long envelope_version_ = -1;  // the bodies' circle, for this state of the material
+  mutable double envelope_ = 0;
   std::set<std::tuple<std::string, int, std::string>> seen_;
   std::set<std::tuple<double, double, double, int, long, double, double>> turned_;  // rotary sweeps already checked
 
@@ -606,7 +612,10 @@ class Checker : public gcode::MachineInterface {
   // The circle every body on the table sweeps when C turns (whatever its height: below the
   // clearance plane the margin is the plane's, not the bodies' tops).
   double envelope() const {
-    double env = scene_.material.envelope(m_.c_axis_centre_mm, -kInf);
+    if (envelope_version_ == scene_.material.version()) return envelope_;
+    envelope_version_ = scene_.material.version();
+    double& env = envelope_;
+    env = scene_.material.envelope(m_.c_axis_centre_mm, -kInf);
     for (const auto& s : scene_.spheres) env = std::max(env, (s.c.head<2>() - m_.c_axis_centre_mm).norm() + s.r);
     for (const auto& c : scene_.cyls) env = std::max(env, (c.c - m_.c_axis_centre_mm).norm() + c.r);
     return env;
@@ -732,6 +741,7 @@ Report checkPrograms(const std::vector<ProgramText>& programs, const parts::Mach
     // before anything else happens.
     const auto lines = ck.probeLines();
     const auto outcomes = ck.outcomes();
+    const auto tips = ck.probeTips();
     std::set<int> done;
     for (std::size_t k = 0; k < lines.size(); ++k) {
       // A program that stopped on its last probe move: that move's outcome was already the
@@ -757,7 +767,7 @@ Report checkPrograms(const std::vector<ProgramText>& programs, const parts::Mach
                contact ? "measuring move: when the probe does not trigger the program goes on to " + went_on + " instead of stopping"
                        : "positioning probe move: when the probe touches something the program goes on to " + went_on +
                              " instead of stopping",
-               outcomes[k].stop.xyz_mm, contact ? "no contact -> error (G38.2, or G31 with a check and #3000)"
+               tips[k], contact ? "no contact -> error (G38.2, or G31 with a check and #3000)"
                                                 : "contact -> ABORT / #3000 (G38.3 + #5070 check, or G31 with a check)");
     }
     ck.restore(end);

@@ -119,7 +119,8 @@ TEST(SafetyVerifier, UnprotectedProbeMoves) {
   }
   auto r = s.check(t);
   EXPECT_TRUE(has(r, "probe-unprotected", lineOf(t, "G38.3"))) << listed(r);
-  EXPECT_EQ(r.findings.size(), 1u) << listed(r);
+  ASSERT_EQ(r.findings.size(), 1u) << listed(r);
+  EXPECT_NEAR(r.findings[0].where_mm.z(), 75.0, 1e-9);  // the stylus-tip centre where the move ends, not the gauge line
   // Fanuc: the measuring move's check removed (G31 goes on to the DPRNT without a trigger).
   const std::string f = gcode::writeFanucMacroB(s.program(s.probing()));
   std::string g;

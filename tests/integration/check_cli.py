@@ -15,7 +15,7 @@
 
 Needs $PROBELOOP and $PROBELOOP_SOURCE_DIR.
 """
-import json, os, re, subprocess, sys, tempfile, time
+import json, os, re, shutil, subprocess, sys, tempfile, time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks  # noqa: E402
@@ -210,4 +210,6 @@ open(f"{W}/bad_word.ngc", "w").write("\n".join(lines))
 code, o, e = run("check", f"{W}/bad_word.ngc", "--machine", MACHINES["linuxcnc_rotary_mill"], "--part", PIECES["sphere"])
 check("a word the interpreter does not model: exit 2 with file:line", code == 2 and f"bad_word.ngc:{i + 2}:" in e, e)
 print(f"     {time.time() - t0:.1f} s")
+if not check.failed:
+    shutil.rmtree(W, ignore_errors=True)  # kept on failure, for a look at the edited programs
 check.finish()
