@@ -152,6 +152,26 @@ TEST(SafetyVerifier, RotaryMoveBelowTheClearancePlane) {
   EXPECT_EQ(r.findings.size(), 1u) << listed(r);
 }
 
+TEST(SafetyVerifier, RotaryMoveOutsideTheBodiesCircleIsAllowed) {
+  SphereSetup s;
+  // Below the clearance plane but 197 mm from the C axis: the sphere (out to 175 mm) cannot
+  // reach the probe while the table turns (the thermal test piece indexes C like this).
+  const std::string t = gcode::writeLinuxCnc(s.program({gcode::Rapid{-200.0, 0.0, std::nullopt}, gcode::ProtectedMove{-200, 0, 75, 1000},
+                                                        gcode::RotateC{90}}));
+  const auto r = s.check(t);
+  EXPECT_TRUE(r.safe()) << listed(r);
+}
+
+TEST(SafetyVerifier, MeasuringMoveThatMeetsNothingStopsTheProgram) {
+  SphereSetup s;
+  // 30 mm off the sphere in Y: G38.2 ends without contact, LinuxCNC stops the program there.
+  const std::string t = gcode::writeLinuxCnc(s.program({gcode::Rapid{-139.0, 30.0, std::nullopt}, gcode::ProtectedMove{-139, 30, 75, 1000},
+                                                        gcode::ProbeMove{-144, 30, 75, 200, 1, 1}}));
+  const auto r = s.check(t);
+  EXPECT_TRUE(has(r, "program-stops", lineOf(t, "G38.2"))) << listed(r);
+  EXPECT_EQ(r.findings.size(), 1u) << listed(r);
+}
+
 TEST(SafetyVerifier, SpindleWithTheProbe) {
   SphereSetup s;
   auto ops = s.probing();
