@@ -207,7 +207,24 @@ TEST(SafetyVerifier, MaterialCutByTheProgramIsGone) {
   std::string off = t;
   off.replace(off.find("S3000 M3\n"), 9, "");
   r = checkPrograms({{"cut.ngc", off}}, m, piece);
-  EXPECT_TRUE(has(r, "collision", 9)) << listed(r);
+  EXPECT_TRUE(has(r, "collision", 11)) << listed(r);
+}
+
+TEST(SafetyVerifier, TurningTheTableUnderTheCutterCutsARing) {
+  const auto m = parts::loadMachine(src() + "/parts/machines/linuxcnc_rotary_mill.yaml");
+  const auto piece = parts::loadTestPiece(src() + "/examples/workpiece_block.yaml");
+  // The block (X -40..40, Y -30..30) on the C axis; T1 (d10) at X45 Z30 while C turns once
+  // removes everything 40 mm or more from the axis above Z30 (the block's corners). Then, out
+  // to X60, over to Y25 and in to X41 Y25 (the tool never nearer the axis than 43 mm) is
+  // clear; without the turn the last rapid meets the corner that is still there. (A straight
+  // rapid from X45 Y0 to X41 Y25 would not be clear: it passes 39.4 mm from the axis.)
+  const std::string head = "G21 G90 G17 G40 G49 G80 G94\nG10 L2 P6 X0 Y0 Z0 C0\nG59\nT1 M6\nG43 H1\nG0 X45 Y0\nG0 Z30\nS3000 M3\n";
+  const std::string turn = "G91 G1 C360 F3000\nG90\n";
+  const std::string tail = "G0 X60\nG0 Y25\nG0 X41\nG0 Z100\nM5\nM2\n";
+  auto r = checkPrograms({{"ring.ngc", head + turn + tail}}, m, piece);
+  EXPECT_TRUE(r.safe()) << listed(r);
+  r = checkPrograms({{"ring.ngc", head + tail}}, m, piece);
+  EXPECT_TRUE(has(r, "collision", 11)) << listed(r);
 }
 
 TEST(SafetyVerifier, UnknownToolIsBadInput) {
