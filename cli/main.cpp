@@ -36,6 +36,7 @@
 #include "report/ttp_scene.hpp"
 #include "sim/rigid_campaign.hpp"
 #include "sim/virtual_machine.hpp"
+#include "verify/safety.hpp"
 
 using namespace probeloop;
 namespace fs = std::filesystem;
@@ -106,6 +107,16 @@ int cmdPlan(const std::string& piece_file, const std::string& machine_file, cons
     std::fputs(comp->basis.c_str(), stdout);
   }
   const auto plan = planner::planTestPiece(piece, machine, dialect, out_dir, experiment, comp ? &*comp : nullptr);
+  // The safety verifier reads every program as a controller would (independent of the planner):
+  // any finding refuses the plan before anything is written.
+  std::vector<verify::ProgramText> texts;
+  for (const auto& p : plan.programs) texts.push_back({p.file, p.text});
+  const auto safety = verify::checkPrograms(texts, machine, piece);
+  if (!safety.safe()) {
+    std::fprintf(stderr, "probeloop: error: plan refused: the safety verifier found %zu problem(s) in the programs; nothing written\n%s",
+                 safety.findings.size(), verify::reportText(safety).c_str());
+    return 3;
+  }
   // Everything is planned and checked before the first file is written.
   for (const auto& p : plan.programs) writeFileAtomic(join(out_dir, p.file), p.text);
   for (const auto& [name, content] : plan.files) writeFileAtomic(join(out_dir, name), content);
@@ -113,6 +124,29 @@ int cmdPlan(const std::string& piece_file, const std::string& machine_file, cons
   std::fputs(plan.summary.c_str(), stdout);
   std::fputs(evaluate::planPrediction(plan.manifest, machine.x.resolution_mm).c_str(), stdout);
   return 0;
+}
+
+// Exit 0: safe; 3: findings (listed); 2: input the verifier cannot read (file:line: field).
+int cmdCheck(const std::vector<std::string>& program_files, const std::string& machine_file, const std::string& part_file,
+             bool json) {
+  try {
+    const auto machine = parts::loadMachine(machine_file);
+    const auto piece = parts::loadTestPiece(part_file);
+    std::vector<verify::ProgramText> texts;
+    for (const auto& f : program_files) texts.push_back({f, readFile(f)});
+    const auto r = verify::checkPrograms(texts, machine, piece);
+    if (json) {
+      std::fputs(verify::reportJson(r).c_str(), stdout);
+    } else {
+      std::fputs(verify::reportText(r).c_str(), stdout);
+      std::printf("%s: %zu finding(s) in %zu program(s)\nmodel: %s\n", r.safe() ? "safe" : "UNSAFE", r.findings.size(),
+                  r.programs.size(), r.model.c_str());
+    }
+    return r.safe() ? 0 : 3;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "probeloop: error: %s\n", e.what());
+    return 2;
+  }
 }
 
 int cmdResolution(const std::string& artifact_file, const std::string& machine_file, double step_um) {
@@ -407,6 +441,17 @@ int main(int argc, char** argv) {
   simc->add_option("--schedule", schedule, "plan manifest (plan.json): start each program at its planned time, the machine "
                    "off in between (the stepped workpiece's 3 h waits)")->check(CLI::ExistingFile);
 
+  std::vector<std::string> check_programs;
+  bool check_json = false;
+  auto* chk = app.add_subcommand("check", "Safety verifier: travel, collisions, probe protection, rotary moves and spindle "
+                                          "checked from the program text (exit 0 safe, 3 findings, 2 bad input)");
+  chk->add_option("programs", check_programs, "G-code programs (.ngc LinuxCNC, .nc Fanuc macro B), run back to back "
+                  "(material cut by one is gone for the next)")->required()->check(CLI::ExistingFile);
+  chk->add_option("--machine", machine, "machine description (YAML)")->required()->check(CLI::ExistingFile);
+  chk->add_option("--part", part, "what stands on the table: a sphere artifact, a thermal test piece, a stepped workpiece "
+                  "or a workpiece (YAML)")->required()->check(CLI::ExistingFile);
+  chk->add_flag("--json", check_json, "the report as JSON");
+
   std::string compare_with;
   auto* ev = app.add_subcommand("evaluate", "Errors of a test piece from probe logs, points CSV, a CMM export or dial-gauge readings");
   ev->add_option("points", points, "LinuxCNC log, Fanuc DPRNT output, points CSV, CMM export (CSV, QIF 3.0 Results or DMIS output) or gauge CSV")->required()->check(CLI::ExistingFile);
@@ -479,6 +524,7 @@ int main(int argc, char** argv) {
     if (*res) return cmdResolution(artifact, machine, step_um);
     if (*rd) return cmdRead(read_file, read_json);
     if (*syn) return cmdSynth(manifest, truth, out, seed);
+    if (*chk) return cmdCheck(check_programs, machine, part, check_json);
     if (*simc) return cmdSimulate(sim_programs, machine, part, truth, out, seed, cmm_points, sim_trace, schedule);
     if (*fit) return cmdFit(fa);
     if (*gum) return cmdGum(gum_model, gum_mcm || gum_trials > 0, gum_trials, seed, gum_digits, gum_json);

@@ -159,6 +159,8 @@ Machine loadMachine(const std::string& path) {
   mc.tool_change.time_s = tc.quantity("time", Dimension::Duration);
   mc.tool_change.z_mm = tc.quantity("z", Dimension::Length);
   mc.tool_change.empty_tool = tc.integer("empty_tool");
+  mc.tool_change.holder_diameter_mm = tc.quantityOr("holder_diameter", Dimension::Length, 63);
+  if (!(mc.tool_change.holder_diameter_mm > 0)) tc.fail("holder_diameter", "must be positive");
   if (mc.tool_change.time_s < 0) tc.fail("time", "must not be negative");
   if (mc.tool_change.z_mm < mc.z.min_mm || mc.tool_change.z_mm > mc.z.max_mm)
     tc.fail("z", "tool-change Z is outside the Z travel");
@@ -172,6 +174,16 @@ Machine loadMachine(const std::string& path) {
   mc.probe.tool_change_repeatability_2sigma_um = pr.quantityOr("tool_change_repeatability_2sigma", Dimension::Micrometre, NAN);
   if (pr.has("tool_change_repeatability_2sigma") && !(mc.probe.tool_change_repeatability_2sigma_um >= 0))
     pr.fail("tool_change_repeatability_2sigma", "must be >= 0");
+  mc.probe.stylus_diameter_mm = pr.quantityOr("stylus_diameter", Dimension::Length, 0.75 * mc.probe.tip_diameter_mm);
+  mc.probe.stylus_length_mm = pr.quantityOr("stylus_length", Dimension::Length, 50);
+  mc.probe.body_diameter_mm = pr.quantityOr("body_diameter", Dimension::Length, 63);
+  mc.probe.max_overtravel_mm = pr.quantityOr("max_overtravel", Dimension::Length, 5);
+  if (!(mc.probe.stylus_diameter_mm > 0) || mc.probe.stylus_diameter_mm > mc.probe.tip_diameter_mm)
+    pr.fail("stylus_diameter", "must be positive and at most the tip diameter");
+  if (!(mc.probe.stylus_length_mm > 0) || mc.probe.stylus_length_mm > mc.probe.length_mm)
+    pr.fail("stylus_length", "must be positive and at most the probe length");
+  if (!(mc.probe.body_diameter_mm > 0)) pr.fail("body_diameter", "must be positive");
+  if (!(mc.probe.max_overtravel_mm > 0)) pr.fail("max_overtravel", "must be positive");
   if (mc.probe.tool <= 0) pr.fail("tool", "probe tool number must be positive");
   if (mc.probe.tool == mc.tool_change.empty_tool)
     pr.fail("tool", "probe tool number equals tool_change.empty_tool");

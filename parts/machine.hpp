@@ -40,12 +40,22 @@ struct ProbeSpec {
   double tip_diameter_mm = 0;
   double repeatability_2sigma_um = 0;   // manufacturer's unidirectional repeatability (2 sigma)
   double tool_change_repeatability_2sigma_um = NAN;  // of the probe's position after a tool change; NaN = not stated
+  // Geometry for the safety verifier (verify/safety.hpp); optional keys, defaults of a
+  // Renishaw OMP60 with an M4 stylus: stylus shaft diameter 0.75 x the tip's, 50 mm from the
+  // tip centre to the probe body, body 63 mm across; overtravel 5 mm past the contact.
+  double stylus_diameter_mm = 0;        // 0 = 0.75 x tip_diameter
+  double stylus_length_mm = 50;         // tip centre to the bottom of the probe body
+  double body_diameter_mm = 63;         // the probe body, from the stylus up to the gauge line
+  double max_overtravel_mm = 5;         // how far a probing move may go past the contact
 };
 
 struct ToolChangeSpec {
   double time_s = 0;                    // one tool change, chip to chip
   double z_mm = 0;                      // machine Z of the gauge line for tool changes (G53)
   int empty_tool = 0;                   // the tool number that empties the spindle
+  // The tool holder of every cutting tool (safety verifier): a cylinder of this diameter from
+  // the tool's stickout up to the gauge line (key tool_change.holder_diameter; SK40/HSK-A63 size).
+  double holder_diameter_mm = 63;
 };
 
 struct Machine {
