@@ -1,0 +1,185 @@
+// The fast paths of the least-squares engine against the plain ones: statistics from the
+// fit's last pass (keep_residuals = false) against the residual vector, the hashed
+// duplicate search against a brute-force pair search, and scans that start far from the
+// solution (coarse stage on a subsample, last step without a pass) against small sets
+// fitted the verified way. Accuracy itself is pinned by ls_reference_test.cpp and
+// nist_reference_test.cpp.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include "core/error.hpp"
+#include "geometry/least_squares.hpp"
+
+using namespace probeloop;
+using namespace probeloop::geometry;
+using Eigen::Vector3d;
+
+namespace {
+
+// Noisy points on an element: sphere cap, full cylinder, cone band, circle, plane patch.
+Points3 noisyPoints(ElementKind kind, std::size_t n, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> noise(0.0, 1e-3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  Points3 p;
+  p.reserve(n);
+  const Vector3d o(412.5, -233.25, 118.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double a = 2.0 * M_PI * u(rng), t = u(rng), e = noise(rng);
+    switch (kind) {
+      case ElementKind::Sphere: {
+        const double pol = 1.2 * t;  // a cap of 2 x 69 deg
+        p.push_back(o + (25.0 + e) * Vector3d(std::sin(pol) * std::cos(a), std::sin(pol) * std::sin(a),
+                                              std::cos(pol)));
+        break;
+      }
+      case ElementKind::Cylinder:
+        p.push_back(o + Vector3d((20.0 + e) * std::cos(a), (20.0 + e) * std::sin(a), 80.0 * t));
+        break;
+      case ElementKind::Cone: {
+        const double z = 40.0 * t, r = 10.0 + z * std::tan(0.3);
+        p.push_back(o + Vector3d((r + e) * std::cos(a), (r + e) * std::sin(a), z));
+        break;
+      }
+      case ElementKind::Circle3D:
+        p.push_back(o + Vector3d((30.0 + e) * std::cos(a), (30.0 + e) * std::sin(a), 0.0));
+        break;
+      default:
+        p.push_back(o + Vector3d(100.0 * u(rng), 60.0 * t, e + 0.01 * (u(rng) - 0.5)));
+    }
+  }
+  return p;
+}
+
+}  // namespace
+
+TEST(LeastSquaresEngine, StatisticsWithoutResidualsMatchTheResidualVector) {
+  for (ElementKind kind : {ElementKind::Plane, ElementKind::Circle3D, ElementKind::Sphere,
+                           ElementKind::Cylinder, ElementKind::Cone}) {
+    for (std::size_t n : {std::size_t{50}, std::size_t{5000}, std::size_t{60000}}) {
+      const Points3 p = noisyPoints(kind, n, 7 + n);
+      const FitResult full = fitLeastSquares(kind, p);
+      LeastSquaresOptions o;
+      o.keep_residuals = false;
+      const FitResult stats = fitLeastSquares(kind, p, o);
+      SCOPED_TRACE(std::string(elementName(kind)) + " n=" + std::to_string(n));
+      ASSERT_EQ(full.residuals_mm.size(), n);
+      EXPECT_TRUE(stats.residuals_mm.empty());
+      // The same element: both runs are the same computation up to the statistics.
+      EXPECT_EQ(stats.element.position_mm, full.element.position_mm);
+      EXPECT_EQ(stats.element.radius_mm, full.element.radius_mm);
+      EXPECT_EQ(stats.dof, full.dof);
+      // Statistics of the last pass against those of signedDistance at the reported element:
+      // a step of at most 1e-12 of the data size apart (a picometre here).
+      EXPECT_NEAR(stats.ssr_mm2, full.ssr_mm2, 1e-9 * full.ssr_mm2);
+      EXPECT_NEAR(stats.rms_mm, full.rms_mm, 1e-9 * full.rms_mm);
+      EXPECT_NEAR(stats.form_mm, full.form_mm, 1e-9);
+      EXPECT_NEAR(stats.residual_variance_mm2, full.residual_variance_mm2,
+                  1e-9 * full.residual_variance_mm2);
+    }
+  }
+}
+
+TEST(LeastSquaresEngine, HashedDuplicateSearchFindsWhatAPairSearchFinds) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-50.0, 50.0);
+  std::uniform_int_distribution<int> pick(0, 399);
+  for (int trial = 0; trial < 40; ++trial) {
+    Points3 p;
+    for (int i = 0; i < 400; ++i) p.emplace_back(u(rng), u(rng), 0.3 * u(rng) + 0.01 * i);
+    // Plant a near-duplicate in half the trials: 0.6 pm apart, straddling a 1 nm cell face
+    // in x on odd trials (the case the neighbour look-up exists for).
+    const bool planted = trial % 2 == 0 || trial % 4 == 1;
+    int a = pick(rng), b = pick(rng);
+    if (a == b) b = (a + 1) % 400;
+    if (planted) {
+      p[b] = p[a] + Vector3d(0.6e-9, 0.0, 0.0);
+      if (trial % 4 == 1) {
+        const double face = std::floor(p[a].x() * 1e6) / 1e6;
+        p[a].x() = face - 0.3e-9;
+        p[b] = p[a] + Vector3d(0.6e-9, 0.0, 0.0);
+      }
+    }
+    bool brute = false;
+    for (std::size_t i = 0; i < p.size(); ++i)
+      for (std::size_t j = i + 1; j < p.size(); ++j) brute = brute || (p[i] - p[j]).norm() <= 1e-9;
+    bool refused = false;
+    try {
+      fitLeastSquares(ElementKind::Plane, p);
+    } catch (const GeometryError& e) {
+      refused = std::string(e.what()).find("coincide") != std::string::npos;
+      if (refused) {
+        const std::string want = std::to_string(std::min(a, b) + 1) + " and " +
+                                 std::to_string(std::max(a, b) + 1);
+        EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
+      }
+    }
+    EXPECT_EQ(refused, brute) << "trial " << trial;
+    EXPECT_EQ(brute, planted) << "trial " << trial;
+  }
+}
+
+TEST(LeastSquaresEngine, DuplicateSearchLimitIsAnOption) {
+  Points3 p = noisyPoints(ElementKind::Plane, 5000, 3);
+  p[4321] = p[17];
+  EXPECT_NO_THROW(fitLeastSquares(ElementKind::Plane, p));  // 5000 > 4096: a scan
+  LeastSquaresOptions o;
+  o.duplicate_search_max_points = 10000;
+  try {
+    fitLeastSquares(ElementKind::Plane, p, o);
+    ADD_FAILURE() << "the duplicate was not found";
+  } catch (const GeometryError& e) {
+    EXPECT_NE(std::string(e.what()).find("points 18 and 4322 coincide"), std::string::npos)
+        << e.what();
+  }
+}
+
+// A scan (coarse stage on a subsample, last Gauss-Newton step taken without a pass) lands on
+// the optimum: for the sphere against a plain Gauss-Newton written here (normal equations
+// summed in long double, iterated until the step is below 1e-13 mm), for the cylinder
+// against the same scan fitted from a start 0.3 mm and 10 mrad away.
+TEST(LeastSquaresEngine, ScanReachesTheOptimum) {
+  const Points3 p = noisyPoints(ElementKind::Sphere, 200000, 5);
+  LeastSquaresOptions o;
+  o.keep_residuals = false;
+  const FitResult fit = fitLeastSquares(ElementKind::Sphere, p, o);
+  Vector3d c(412.5, -233.25, 118.0);
+  double r = 25.0;
+  for (int it = 0; it < 50; ++it) {
+    Eigen::Matrix<long double, 4, 4> a = Eigen::Matrix<long double, 4, 4>::Zero();
+    Eigen::Matrix<long double, 4, 1> b = Eigen::Matrix<long double, 4, 1>::Zero();
+    for (const auto& q : p) {
+      const Vector3d v = q - c;
+      const double rho = v.norm();
+      Eigen::Matrix<long double, 4, 1> j;
+      j << -v.x() / rho, -v.y() / rho, -v.z() / rho, -1.0;
+      a += j * j.transpose();
+      b += j * static_cast<long double>(rho - r);
+    }
+    const Eigen::Matrix<long double, 4, 1> step = -a.ldlt().solve(b);
+    c += Vector3d(static_cast<double>(step(0)), static_cast<double>(step(1)),
+                  static_cast<double>(step(2)));
+    r += static_cast<double>(step(3));
+    if (step.cwiseAbs().maxCoeff() < 1e-13) break;
+  }
+  EXPECT_LT((fit.element.position_mm - c).norm(), 1e-10);
+  EXPECT_LT(std::abs(fit.element.radius_mm - r), 1e-10);
+
+  const Points3 q = noisyPoints(ElementKind::Cylinder, 200000, 6);
+  const FitResult at = fitLeastSquares(ElementKind::Cylinder, q, o);
+  LeastSquaresOptions poor = o;
+  Element s = at.element;
+  s.position_mm += Vector3d(0.3, -0.2, 0.25);
+  s.radius_mm += 0.2;
+  s.direction = (s.direction + Vector3d(0.01, -0.008, 0.0)).normalized();
+  poor.start = s;
+  const FitResult from_poor = fitLeastSquares(ElementKind::Cylinder, q, poor);
+  const Vector3d d = at.element.direction;
+  const Vector3d off = from_poor.element.position_mm - at.element.position_mm;
+  EXPECT_LT((off - d * d.dot(off)).norm(), 1e-9);
+  EXPECT_LT(std::abs(from_poor.element.radius_mm - at.element.radius_mm), 1e-9);
+  EXPECT_LT((from_poor.element.direction - d).norm(), 1e-10);
+  EXPECT_NEAR(from_poor.ssr_mm2, at.ssr_mm2, 1e-9 * at.ssr_mm2);
+}
