@@ -49,7 +49,7 @@ for fmt, e in (("binary_little_endian", "<"), ("binary_big_endian", ">")):
     put("ply", f"hostile_{fmt}_negative_list.ply",
         (f"ply\nformat {fmt} 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
          "property list char float l\nend_header\n").encode() + struct.pack(e + "fffb", 1, 2, 3, -1) + b"\0" * 16)
-put("ply", "hostile_huge_count.ply", hdr("ascii", "99999999999999999999") + "0 0 0\n")
+put("ply", "regress-element-count-1e20.ply", hdr("ascii", "99999999999999999999") + "0 0 0\n")
 put("ply", "hostile_huge_count_binary.ply", hdr("binary_little_endian", "1e300").encode() + b"\0" * 16)
 put("ply", "hostile_empty_elements.ply",
     "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
@@ -68,7 +68,7 @@ put("xyz", "hostile_crlf_bom.xyz", "\ufeff1 2 3\r\n4 5 6\r\n")
 for f in ("Sphere/sph9.ds", "Plane/pla7.ds", "Cone/con7.ds", "Cylinder/cyl27.ds"):
     copy("nist_ds", os.path.join(NIST, f))
 put("nist_ds", "hostile_count_huge.ds", "99999999999\n0 0 0\n")
-put("nist_ds", "hostile_count_1e300.ds", "1e300\n0 0 0\n")
+put("nist_ds", "regress-count-1e300.ds", "1e300\n0 0 0\n")
 put("nist_ds", "hostile_count_negative.ds", "-3\n0 0 0\n")
 put("nist_ds", "hostile_count_short.ds", "4\n0 0 0\n1 1 1\n")
 put("nist_ds", "hostile_nan.ds", "2\n0 0 nan\ninf 0 0\n")
