@@ -80,7 +80,7 @@ put("fit_csv", "hostile_both_separators.csv", "x,y;z\n1,2;3\n")
 copy("fit_csv", os.path.join(ROOT, "examples", "block_cmm_points.csv"))
 
 # --- points CSV, probe logs (sphere artifact plan: fuzz/fixtures/sphere_plan.json) ---------------
-put("points_csv", "hostile_cycle_huge.csv", "cycle,c_deg,x_mm,y_mm,z_mm\n99999999999,0,0,0,0\n2147483648,0,1,1,1\n")
+put("points_csv", "regress-cycle-1e11.csv", "cycle,c_deg,x_mm,y_mm,z_mm\n99999999999,0,0,0,0\n2147483648,0,1,1,1\n")
 put("points_csv", "hostile_nan.csv", "cycle,c_deg,x_mm,y_mm,z_mm,point\n1,nan,0,0,0,1\n1,0,inf,0,0,-1\n1,1e308,0,0,0,0\n")
 put("points_csv", "cycle_starts.csv", "cycle,start_s\n1,0\n2,3600\n3,7200\n")
 put("points_csv", "hostile_cycle_starts.csv", "cycle,start_s\n1,0\n1,0\n-5,1e308\n3,nan\n")
@@ -136,6 +136,9 @@ put("compensation_json", "compensation.json",
     '{"format": "probeloop-compensation", "kind": "stepped_workpiece", "experiment": "W8", "steps": ['
     '{"step": 1, "wall_um": {"XP": 1.5, "XN": -2, "YP": 0, "YN": 3}, "floor_um": 4, "U_wall_um": {"XP": 1, "XN": 1, "YP": 1, "YN": 1}, "U_floor_um": 2},'
     '{"step": 2, "wall_um": {"XP": 0, "XN": 0, "YP": 0, "YN": 0}, "floor_um": 0}], "basis": "hand"}')
+put("compensation_json", "regress-step-1e300.json",
+    '{"format": "probeloop-compensation", "kind": "stepped_workpiece", "experiment": "W8", "steps": ['
+    '{"step": 1e300, "wall_um": {"XP": 0, "XN": 0, "YP": 0, "YN": 0}, "floor_um": 0}]}')
 for h in ("compensation_json", "manifest_json"):
     put(h, "hostile_deep.json", "[" * 20000 + "]" * 20000)
     put(h, "hostile_numbers.json", '{"format": "probeloop-compensation", "steps": [{"step": 1e400, "wall_um": {"XP": NaN}}], '
