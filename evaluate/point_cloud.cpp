@@ -261,9 +261,9 @@ void readPly(PointCloud& pc, const std::string& text) {
         least += static_cast<std::size_t>(plyTypeSize(p.count_type.empty() ? p.type : p.count_type));
       if (least == 0) continue;  // no properties: nothing to read
       if (static_cast<std::size_t>(el.count) > (text.size() - pos) / least)
-        throw InputError(pc.file, 0, "PLY: element '" + el.name + "' declares " + std::to_string(el.count) +
-                                         " entries of at least " + std::to_string(least) + " bytes, the binary data has " +
-                                         std::to_string(text.size() - pos) + " bytes left");
+        throw InputError(pc.file, 0, "PLY: binary data ends inside element '" + el.name + "': it declares " +
+                                         std::to_string(el.count) + " entries of at least " + std::to_string(least) +
+                                         " bytes, " + std::to_string(text.size() - pos) + " bytes are left");
     }
     for (long i = 0; i < el.count; ++i) {
       Eigen::Vector3d v = Eigen::Vector3d::Zero();
