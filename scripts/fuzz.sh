@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Coverage-guided fuzzing of every reader (fuzz/README.md, docs/reliability.md):
 #   scripts/fuzz.sh [SECONDS_PER_HARNESS] [HARNESS...]     default: 60 s, every harness
-# Installs clang when missing (apt-get, as scripts/setup.sh does), builds build-fuzz/ with clang,
+# Installs clang and the build dependencies when missing (apt-get, as scripts/setup.sh does), builds build-fuzz/ with clang,
 # libFuzzer, ASan and UBSan (-DPROBELOOP_FUZZ=ON), then runs the harnesses one after another,
 # each on a scratch copy of its corpus (fuzz/corpus/ is never written), with its dictionary,
 # -max_len, -timeout and -rss_limit_mb. Crash, leak, timeout and OOM inputs land in
@@ -24,9 +24,11 @@ done
 
 nice_cmd=(nice -n "${FUZZ_NICE:-0}")
 if [ -z "${FUZZ_SKIP_BUILD:-}" ]; then
-  scripts/setup.sh
+  # What the libraries build with (scripts/setup.sh's list without the test-only tools) and
+  # clang with its sanitizer and libFuzzer runtimes.
   missing=()
-  for p in clang libclang-rt-14-dev; do
+  for p in cmake make clang libclang-rt-14-dev libeigen3-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev \
+           libtinygltf-dev libgtest-dev libcgal-dev libgmp-dev libmpfr-dev libceres-dev libboost-dev libxml2-dev; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
   done
   if [ ${#missing[@]} -gt 0 ]; then
