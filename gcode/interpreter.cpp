@@ -181,9 +181,11 @@ class Execution {
   int nesting_ = 0;
   struct Nest {
     Nest(Execution& e, const std::string& line, std::size_t column) : e_(e) {
-      if (++e_.nesting_ > kMaxNesting)
+      if (++e_.nesting_ > kMaxNesting) {
+        --e_.nesting_;  // a constructor that throws gets no destructor call
         e_.fail("expression nested more than " + std::to_string(kMaxNesting) + " levels deep (brackets, signs or #) at column " +
                 std::to_string(column + 1) + " of '" + line.substr(0, 60) + (line.size() > 60 ? "...'" : "'"));
+      }
     }
     ~Nest() { --e_.nesting_; }
     Nest(const Nest&) = delete;
