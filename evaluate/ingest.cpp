@@ -73,6 +73,10 @@ std::vector<ProbeRecord> fromCsv(const std::string& text, const std::string& fil
     const double cyc = t.number(row, c_cycle);
     if (cyc != std::round(cyc) || cyc < 1)
       throw InputError(file, row.line, "cycle must be a positive integer");
+    // Checked here, before the conversion to int (1e11 was undefined behaviour: fuzz/points_csv).
+    if (cyc > m.cycles)
+      throw InputError(file, row.line, "cycle " + formatNumber(cyc) + " is beyond the plan's " + std::to_string(m.cycles) +
+                                           " cycles");
     r.cycle = static_cast<int>(cyc);
     const double c = t.number(row, c_c);
     r.tip_mm = {t.number(row, c_x), t.number(row, c_y), t.number(row, c_z)};
@@ -88,6 +92,10 @@ std::vector<ProbeRecord> fromCsv(const std::string& text, const std::string& fil
         const double p = t.number(row, c_pt);
         if (p != std::round(p) || p < 1)
           throw InputError(file, row.line, "point must be a positive integer");
+        if (p > m.pointsPerSphere())
+          throw InputError(file, row.line, "point " + formatNumber(p) + " of position " + std::to_string(r.position) +
+                                               " is not planned (" + std::to_string(m.pointsPerSphere()) +
+                                               " points per position)");
         r.point = static_cast<int>(p);
       }
     }

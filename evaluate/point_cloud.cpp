@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cctype>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <sstream>
@@ -93,6 +94,10 @@ void readCsv(PointCloud& pc, const std::string& text, const std::string& feature
     throw InputError(pc.file, 0, "no rows with feature '" + feature + "'");
 }
 
+// The largest count of points or PLY elements a header may declare (far above any cloud that
+// fits in memory); larger ones are refused before they are converted to an integer.
+constexpr double kMaxCount = 2147483647.0;
+
 void readDs(PointCloud& pc, const std::string& text) {
   std::istringstream in(text);
   std::string line;
@@ -104,8 +109,10 @@ void readDs(PointCloud& pc, const std::string& text) {
     if (t.empty()) continue;
     if (expected < 0) {
       double v = 0;
-      if (t.size() != 1 || !parseFiniteNumber(t[0], v) || v < 1 || v != std::floor(v))
-        throw InputError(pc.file, n, "NIST .ds: the first line must be the number of points");
+      // Bounded before the conversion: a count beyond long was undefined behaviour (fuzz/nist_ds).
+      if (t.size() != 1 || !parseFiniteNumber(t[0], v) || v < 1 || v != std::floor(v) || v > kMaxCount)
+        throw InputError(pc.file, n, "NIST .ds: the first line must be the number of points (a whole number from 1 to " +
+                                         formatNumber(kMaxCount) + "), found '" + line + "'");
       expected = static_cast<long>(v);
       continue;
     }
@@ -199,8 +206,10 @@ void readPly(PointCloud& pc, const std::string& text) {
       encoding = t[1];
     } else if (t[0] == "element") {
       double c = 0;
-      if (t.size() != 3 || !parseFiniteNumber(t[2], c) || c < 0)
-        throw InputError(pc.file, line_no, "PLY: expected 'element <name> <count>'");
+      // A whole count within kMaxCount: 1e20 was converted to long unchecked (fuzz/ply).
+      if (t.size() != 3 || !parseFiniteNumber(t[2], c) || c < 0 || c != std::floor(c) || c > kMaxCount)
+        throw InputError(pc.file, line_no, "PLY: expected 'element <name> <count>' with a whole count from 0 to " +
+                                               formatNumber(kMaxCount) + ", found '" + l + "'");
       elements.push_back({t[1], static_cast<long>(c), {}});
     } else if (t[0] == "property") {
       if (elements.empty()) throw InputError(pc.file, line_no, "PLY: property before any element");
@@ -214,6 +223,10 @@ void readPly(PointCloud& pc, const std::string& text) {
       }
       if (plyTypeSize(p.type) == 0 || (!p.count_type.empty() && plyTypeSize(p.count_type) == 0))
         throw InputError(pc.file, line_no, "PLY: unknown property type '" + p.type + "'");
+      // A list's length is an integer (PLY); a float count read as a size was undefined (fuzz/ply).
+      if (!p.count_type.empty() && (p.count_type.rfind("float", 0) == 0 || p.count_type == "double"))
+        throw InputError(pc.file, line_no, "PLY: the count type of list '" + p.name +
+                                               "' must be an integer type, found '" + p.count_type + "'");
       elements.back().properties.push_back(p);
     } else {
       throw InputError(pc.file, line_no, "PLY: unexpected header line '" + l + "'");
@@ -240,6 +253,18 @@ void readPly(PointCloud& pc, const std::string& text) {
   if (ascii) ain.str(text.substr(pos));
   for (const auto& el : elements) {
     const bool is_vertex = &el == &*vertex_it;
+    if (!ascii) {
+      // Each entry takes at least this many bytes; a count the data cannot hold is refused here,
+      // before a loop of 2^31 empty entries (a hang, fuzz/ply).
+      std::size_t least = 0;
+      for (const auto& p : el.properties)
+        least += static_cast<std::size_t>(plyTypeSize(p.count_type.empty() ? p.type : p.count_type));
+      if (least == 0) continue;  // no properties: nothing to read
+      if (static_cast<std::size_t>(el.count) > (text.size() - pos) / least)
+        throw InputError(pc.file, 0, "PLY: binary data ends inside element '" + el.name + "': it declares " +
+                                         std::to_string(el.count) + " entries of at least " + std::to_string(least) +
+                                         " bytes, " + std::to_string(text.size() - pos) + " bytes are left");
+    }
     for (long i = 0; i < el.count; ++i) {
       Eigen::Vector3d v = Eigen::Vector3d::Zero();
       if (ascii) {
@@ -262,6 +287,11 @@ void readPly(PointCloud& pc, const std::string& text) {
           };
           take();
           if (!p.count_type.empty()) {
+            // Checked before the conversion: 1e300 was undefined, a negative count read nothing.
+            if (val < 0 || val != std::floor(val) || val > static_cast<double>(t.size() - at))
+              throw InputError(pc.file, line_no, "PLY: element '" + el.name + "' list '" + p.name + "': count " +
+                                                     t[at - 1] + " is not a whole number of the " +
+                                                     std::to_string(t.size() - at) + " values left on the line");
             const long cnt = static_cast<long>(val);
             for (long j = 0; j < cnt; ++j) take();
           } else if (is_vertex) {
@@ -275,7 +305,7 @@ void readPly(PointCloud& pc, const std::string& text) {
         for (size_t k = 0; k < el.properties.size(); ++k) {
           const auto& p = el.properties[k];
           auto need = [&](size_t bytes) {
-            if (pos + bytes > text.size())
+            if (bytes > text.size() - pos)
               throw InputError(pc.file, 0, "PLY: binary data ends inside element '" + el.name +
                                                "' number " + std::to_string(i + 1));
           };
@@ -285,6 +315,10 @@ void readPly(PointCloud& pc, const std::string& text) {
             const double cnt = plyBinary(reinterpret_cast<const unsigned char*>(text.data() + pos),
                                          p.count_type, big);
             pos += cs;
+            // A negative count became a huge size_t (undefined, then pos wrapped: fuzz/ply).
+            if (cnt < 0)
+              throw InputError(pc.file, 0, "PLY: element '" + el.name + "' number " + std::to_string(i + 1) +
+                                               " list '" + p.name + "': negative count " + formatNumber(cnt));
             const size_t bytes = static_cast<size_t>(cnt) * static_cast<size_t>(plyTypeSize(p.type));
             need(bytes);
             pos += bytes;

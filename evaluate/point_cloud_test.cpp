@@ -124,6 +124,38 @@ TEST(PointCloud, PlyTruncatedAndMissingCoordinatesAreErrors) {
   EXPECT_NE(errorOf(m).find("x, y and z"), std::string::npos) << errorOf(m);
 }
 
+// Found by fuzz/ply_fuzz and fuzz/nist_ds_fuzz: counts converted to integers unchecked
+// (undefined behaviour), a negative binary list count, a count of empty entries that never ends.
+TEST(PointCloud, HostileCountsAreErrorsWithTheLine) {
+  const std::string xyz = "property float x\nproperty float y\nproperty float z\n";
+  const auto huge = writeTemp("huge.ply", "ply\nformat ascii 1.0\nelement vertex 1e20\n" + xyz + "end_header\n0 0 0\n");
+  EXPECT_NE(errorOf(huge).find("huge.ply:3: PLY: expected 'element <name> <count>' with a whole count"), std::string::npos)
+      << errorOf(huge);
+  const auto frac = writeTemp("frac.ply", "ply\nformat ascii 1.0\nelement vertex 1.5\n" + xyz + "end_header\n0 0 0\n");
+  EXPECT_NE(errorOf(frac).find("frac.ply:3:"), std::string::npos) << errorOf(frac);
+  const auto list = writeTemp("list.ply", "ply\nformat ascii 1.0\nelement vertex 1\n" + xyz +
+                                              "property list uchar int l\nend_header\n0 0 0 1e300 1\n");
+  EXPECT_NE(errorOf(list).find("list.ply:9: PLY: element 'vertex' list 'l': count 1e300"), std::string::npos) << errorOf(list);
+  const auto fcount = writeTemp("fcount.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 1\n" + xyz +
+                                                  "property list float int l\nend_header\n");
+  EXPECT_NE(errorOf(fcount).find("fcount.ply:7: PLY: the count type of list 'l' must be an integer type"), std::string::npos)
+      << errorOf(fcount);
+  std::string neg = "ply\nformat binary_little_endian 1.0\nelement vertex 1\n" + xyz + "property list char float l\nend_header\n";
+  neg += std::string(12, '\0') + "\xff" + std::string(16, '\0');
+  EXPECT_NE(errorOf(writeTemp("neg.ply", neg)).find("list 'l': negative count -1"), std::string::npos);
+  // 4e9 entries of nothing, and 2e9 vertices in 12 bytes: refused at once, not looped over.
+  const auto empty = writeTemp("empty.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 1\n" + xyz +
+                                                "element nothing 2147483647\nend_header\n" + std::string(12, '\0'));
+  EXPECT_EQ(readPointCloud(empty, "ply").points_mm.size(), 1u);
+  const auto many = writeTemp("many.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 2000000000\n" + xyz +
+                                              "end_header\n" + std::string(12, '\0'));
+  EXPECT_NE(errorOf(many).find("binary data ends inside element 'vertex': it declares 2000000000 entries of at least 12 bytes, 12 bytes are left"),
+            std::string::npos) << errorOf(many);
+  const auto ds = writeTemp("huge.ds", "1e300\n0 0 0\n");
+  EXPECT_NE(errorOf(ds).find("huge.ds:1: NIST .ds: the first line must be the number of points"), std::string::npos)
+      << errorOf(ds);
+}
+
 TEST(PointCloud, UnknownExtensionAsksForFormat) {
   const auto p = writeTemp("points.dat", "1 2 3\n");
   EXPECT_NE(errorOf(p).find("--format"), std::string::npos);

@@ -720,7 +720,11 @@ TtpEvaluation evaluateImpl(const parts::PlanManifest& m, const TtpPoints& in, co
   for (const char* s : {"Z", "X1", "X2", "Y1", "Y2"})
     if (!ref.by_side.count(s)) throw InputError(m.file, 0, std::string("the manifest has no reference ") + s + " feature (cycle 0)");
 
-  for (const auto& [c, feats] : cf) {
+  // Not a structured binding: lambdas below use feats, which clang before 16 cannot capture
+  // (C++20 P1091; scripts/fuzz.sh builds with clang 14).
+  for (const auto& entry : cf) {
+    const auto& c = entry.first;
+    const auto& feats = entry.second;
     TtpCycleResult cr = cycleResult(c, ph, times);
     if (c == 0) {
       for (int j = 0; j < 6; ++j) cr.values.push_back(zeroBudget(kQuantities[j], kUnits[j], opt.coverage_k));
@@ -857,7 +861,11 @@ TtpEvaluation evaluateThermalTestPieceGauge(const parts::PlanManifest& m, const 
   };
   const double alpha = m.material_alpha_um_per_m_K;
   const double dT = m.ttp.on_machine_temperature_change_K;
-  for (const auto& [c, feats] : cf) {
+  // Not a structured binding: lambdas below use feats, which clang before 16 cannot capture
+  // (C++20 P1091; scripts/fuzz.sh builds with clang 14).
+  for (const auto& entry : cf) {
+    const auto& c = entry.first;
+    const auto& feats = entry.second;
     TtpCycleResult cr = cycleResult(c, ph, times);
     if (c == 0) {
       for (int j : {0, 1, 4, 5}) cr.values.push_back(zeroBudget(kQuantities[j], kUnits[j], opt.coverage_k));

@@ -173,6 +173,26 @@ class Execution {
   // ---------------------------------------------------------------------------------
   // Expressions
 
+  // The expression reader recurses per bracket, unary sign and '#' of an indirect parameter
+  // (##1); without a bound, "[[[[..." of a few thousand levels exhausted the stack (found by
+  // fuzz/gcode_linuxcnc_fuzz). LinuxCNC's lines are at most 256 characters; 100 levels is far
+  // more than any program needs.
+  static constexpr int kMaxNesting = 100;
+  int nesting_ = 0;
+  struct Nest {
+    Nest(Execution& e, const std::string& line, std::size_t column) : e_(e) {
+      if (++e_.nesting_ > kMaxNesting) {
+        --e_.nesting_;  // a constructor that throws gets no destructor call
+        e_.fail("expression nested more than " + std::to_string(kMaxNesting) + " levels deep (brackets, signs or #) at column " +
+                std::to_string(column + 1) + " of '" + line.substr(0, 60) + (line.size() > 60 ? "...'" : "'"));
+      }
+    }
+    ~Nest() { --e_.nesting_; }
+    Nest(const Nest&) = delete;
+    Nest& operator=(const Nest&) = delete;
+    Execution& e_;
+  };
+
   struct Cursor {
     const std::string& s;
     std::size_t i = 0;
@@ -230,6 +250,7 @@ class Execution {
   }
 
   int paramNumber(Cursor& c) {
+    const Nest nest(*this, c.s, c.i);
     const double v = c.peek() == '[' ? bracket(c) : (c.peek() == '#' ? (++c.i, readParam(c)) : number(c));
     const double r = std::round(v);
     if (std::fabs(v - r) > 1e-6 || r < 0 || r > 99999) fail("parameter number " + std::to_string(v) + " is not valid");
@@ -244,6 +265,7 @@ class Execution {
   }
 
   double primary(Cursor& c) {
+    const Nest nest(*this, c.s, c.i);
     if (c.take("-")) return -primary(c);
     if (c.take("+")) return primary(c);
     if (c.peek() == '[') return bracket(c);

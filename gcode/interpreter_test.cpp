@@ -246,6 +246,19 @@ TEST(Interpreter, RefusesWhatItDoesNotModelWithTheLine) {
   expectInputError(ProgramDialect::FanucMacroB, "GOTO 5\n", "bad.ngc:1: GOTO 5: no block N5");
 }
 
+// Found by fuzz/gcode_linuxcnc_fuzz: thousands of nested brackets exhausted the stack.
+TEST(Interpreter, DeepNestingIsRefusedNotAStackOverflow) {
+  const std::string deep = "#1 = " + std::string(20000, '[') + "1" + std::string(20000, ']') + "\n";
+  expectInputError(ProgramDialect::LinuxCnc, "G0 X0\n" + deep, "bad.ngc:2: expression nested more than 100 levels deep");
+  expectInputError(ProgramDialect::FanucMacroB, "#1=" + std::string(20000, '-') + "1\n", "bad.ngc:1: expression nested");
+  expectInputError(ProgramDialect::LinuxCnc, "#1 = " + std::string(20000, '#') + "1\n", "bad.ngc:1: expression nested");
+  // Ninety levels, more than any program needs, still read.
+  Recorder r;
+  Interpreter in(ProgramDialect::LinuxCnc, "ok.ngc", "#1 = " + std::string(90, '[') + "2" + std::string(90, ']') + "\nM2\n");
+  in.run(r);
+  EXPECT_EQ(in.parameter(1), 2.0);
+}
+
 TEST(Interpreter, AnEndlessLoopIsStoppedAndNamed) {
   Recorder r;
   Interpreter in(ProgramDialect::LinuxCnc, "loop.ngc", "o1 while [1]\no1 endwhile\n");

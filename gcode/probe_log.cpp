@@ -69,8 +69,9 @@ std::vector<LoggedProbePoint> parseProbeLog(const std::string& text, const std::
     LoggedProbePoint p;
     p.line = n;
     for (int i = 0; i < 3; ++i) {
-      if (v[i] != std::round(v[i]) || v[i] < 1)
-        throw InputError(file, n, "cycle, position and point must be positive integers, found '" +
+      // Bounded before the conversion to int: 1e300 was undefined behaviour (fuzz/probe_log).
+      if (v[i] != std::round(v[i]) || v[i] < 1 || v[i] > 2147483647.0)
+        throw InputError(file, n, "cycle, position and point must be positive integers (at most 2147483647), found '" +
                                       tok[i + 1] + "'");
     }
     p.cycle = static_cast<int>(v[0]);

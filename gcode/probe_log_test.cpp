@@ -32,6 +32,14 @@ TEST(ProbeLog, ForeignLineNamesFileAndLine) {
   }
   EXPECT_THROW(parseProbeLog("PT 1 1 1 0 nan 0\n", "d.log"), InputError);
   EXPECT_THROW(parseProbeLog("PT 1.5 1 1 0 0 0\n", "e.log"), InputError);
+  // Found by fuzz/probe_log_fuzz: a cycle beyond int was converted unchecked.
+  try {
+    parseProbeLog("PT 1e300 1 1 0 0 0\n", "f.log");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("f.log:1: cycle, position and point must be positive integers"), std::string::npos)
+        << e.what();
+  }
 }
 
 // Fanuc's clock: each PT line's date and time minus the first START's, across midnight and a

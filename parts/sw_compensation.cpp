@@ -48,8 +48,12 @@ SwCompensation loadSwCompensation(const std::string& path) {
     const auto& s = j.at("steps")[i];
     const std::string where = "steps[" + std::to_string(i) + "].";
     SwStepCompensation x;
-    x.step = static_cast<int>(number(s, "step", where, path));
-    if (x.step != static_cast<int>(i) + 1) throw InputError(path, 0, where + "step: expected " + std::to_string(i + 1) + " (in order from the top)");
+    // Compared as a number: converting 1e300 to int first was undefined behaviour, and 1.5 passed as 1.
+    const double step = number(s, "step", where, path);
+    if (step != static_cast<double>(i + 1))
+      throw InputError(path, 0, where + "step: expected " + std::to_string(i + 1) + " (in order from the top), found " +
+                                    formatNumber(step));
+    x.step = static_cast<int>(i) + 1;
     if (!s.contains("wall_um") || !s.at("wall_um").is_object()) throw InputError(path, 0, where + "wall_um: missing");
     for (int w = 0; w < 4; ++w) {
       x.wall_um[w] = number(s.at("wall_um"), kSwWalls[w], where + "wall_um.", path);

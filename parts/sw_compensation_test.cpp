@@ -59,6 +59,10 @@ TEST(SwCompensation, RefusalsNameTheKey) {
   EXPECT_NE(refusal("probeloop-compensation", "qif").find("format: expected"), std::string::npos);
   EXPECT_NE(refusal("stepped_workpiece", "thermal_test_piece").find("kind: expected"), std::string::npos);
   EXPECT_NE(refusal("\"step\": 2", "\"step\": 3").find("steps[1].step: expected 2"), std::string::npos);
+  // Compared as numbers (fuzz review): 1e300 was converted to int unchecked, 1.5 read as 1.
+  EXPECT_NE(refusal("\"step\": 2", "\"step\": 1e300").find("steps[1].step: expected 2 (in order from the top), found 1e+300"),
+            std::string::npos) << refusal("\"step\": 2", "\"step\": 1e300");
+  EXPECT_NE(refusal("\"step\": 2", "\"step\": 2.5").find("steps[1].step: expected 2"), std::string::npos);
   EXPECT_NE(refusal("\"XN\": -1.25, ", "").find("steps[0].wall_um.XN: missing"), std::string::npos);
   EXPECT_NE(refusal("\"floor_um\": -6.5", "\"floor_um\": \"deep\"").find("steps[0].floor_um: expected a number"), std::string::npos);
   EXPECT_NE(refusal("\"floor_um\": 0.5", "\"floor_um\": 600").find("offset 600 um beyond +-500 um"), std::string::npos);
