@@ -213,7 +213,7 @@ void checkDuplicates(ElementKind kind, const Points3& pts) {
   while (size < 2 * n) size *= 2;
   const std::size_t mask = size - 1;
   struct Entry {
-    std::uint64_t key;
+    std::uint32_t key;    // high half of the cell's hash (the low bits give the slot)
     std::uint32_t index;  // point index + 1; 0 marks an empty slot
   };
   std::vector<Entry> table(size, Entry{0, 0});
@@ -224,10 +224,11 @@ void checkDuplicates(ElementKind kind, const Points3& pts) {
     return h ^ (h >> 29);
   };
   auto lookIn = [&](std::size_t i, std::uint64_t key) {
+    const auto high = static_cast<std::uint32_t>(key >> 32);
     for (std::size_t s = key & mask;; s = (s + 1) & mask) {
       const Entry& e = table[s];
       if (e.index == 0) return;
-      if (e.key != key) continue;
+      if (e.key != high) continue;
       const Vector3d d = pts[i] - pts[e.index - 1];
       if ((planar ? d.head<2>().norm() : d.norm()) <= kCoincidentMm)
         reportDuplicate(kind, e.index - 1, i);
@@ -242,9 +243,9 @@ void checkDuplicates(ElementKind kind, const Points3& pts) {
       std::int64_t k = static_cast<std::int64_t>(v);
       if (v < static_cast<double>(k)) --k;  // floor without a libm call
       cell[c] = k;
-      const double frac = (v - static_cast<double>(k)) / kPerMm;  // mm above the lower face
-      if (frac <= kCoincidentMm) side[c] = -1;
-      else if (1.0 / kPerMm - frac <= kCoincidentMm) side[c] = 1;
+      const double frac = v - static_cast<double>(k);  // cells above the lower face
+      if (frac <= kCoincidentMm * kPerMm) side[c] = -1;
+      else if (1.0 - frac <= kCoincidentMm * kPerMm) side[c] = 1;
     }
     const std::uint64_t own = keyOf(cell[0], cell[1], cell[2]);
     if (side[0] == 0 && side[1] == 0 && side[2] == 0) {
@@ -257,7 +258,7 @@ void checkDuplicates(ElementKind kind, const Points3& pts) {
     }
     std::size_t s = own & mask;
     while (table[s].index != 0) s = (s + 1) & mask;
-    table[s] = Entry{own, static_cast<std::uint32_t>(i + 1)};
+    table[s] = Entry{static_cast<std::uint32_t>(own >> 32), static_cast<std::uint32_t>(i + 1)};
   }
 }
 

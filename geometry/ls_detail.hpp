@@ -368,16 +368,18 @@ LmRun<Model> levenbergMarquardt(const Model& model, const typename Model::State&
       const Vec<P> step = dampedStep(run.lin, scale, lambda);
       const double size =
           step.allFinite() ? model.stepSize(step) : std::numeric_limits<double>::infinity();
-      // On a large set (a scan) the last Gauss-Newton step is taken without another pass
-      // over the points when it is negligible (<= kStepTol), or when the iteration
+      // The last Gauss-Newton step is taken without another pass over the points when it
+      // is negligible (<= kStepTol), and on a large set (a scan) also when the iteration
       // contracts by theta = size / previous size per step and the solution is then about
       // theta * size <= kStepTol away (Deuflhard's a-posteriori estimate). The sum of
       // squares moves by the step's predicted decrease |Q^T r|^2; the residual range by at
       // most the step (size times the data size: below a picometre whenever this fires).
-      // Small sets, where a pass costs little, verify every step instead.
-      if (lambda == 0.0 && model.count() > kDenseMax &&
-          (size <= kStepTol || (size <= kContractedStep && std::isfinite(previous_size) &&
-                                size * (size / previous_size) <= kStepTol))) {
+      // Small sets, where a pass costs little, verify a contracted step instead (that
+      // verification is worth the last digits against NIST's reference fits).
+      if (lambda == 0.0 &&
+          (size <= kStepTol ||
+           (model.count() > kDenseMax && size <= kContractedStep &&
+            std::isfinite(previous_size) && size * (size / previous_size) <= kStepTol))) {
         const typename Model::State next = model.apply(run.state, step);
         if (model.valid(next)) {
           run.state = next;
