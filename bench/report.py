@@ -348,7 +348,7 @@ def main():
         if rows:
             ratios = {r["n"]: r["ours_s"] / r["read_pass_s"] for r in rows}
             targets.append((f"LS {kind} ≤ {bound:g}× one read pass for n ≥ {sz(n_min)}",
-                            all(v <= bound for v in ratios.values()),
+                            bool(all(v <= bound for v in ratios.values())),
                             ", ".join(f"{sz(n)}: {v:.1f}×" for n, v in ratios.items())))
     read_pass_target("plane", 3.0, 10000)
     for kind in ("sphere", "cylinder"):
@@ -374,7 +374,7 @@ def main():
     if rnd and rnd[0]["ours_s"]:
         t = rnd[0]["ours_s"]
         targets.append(("MZ roundness on 1e4 points < 50 ms", t < 0.05, f"{t * 1e3:.3g} ms"))
-    summary["targets"] = [{"target": a, "met": b, "numbers": c} for a, b, c in targets]
+    summary["targets"] = [{"target": a, "met": bool(b), "numbers": c} for a, b, c in targets]
 
     # ------------------------------------------------------------ markdown -------------
     cores = os.cpu_count()
