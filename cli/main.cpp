@@ -379,6 +379,7 @@ int cmdFit(const FitArgs& a) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  probeloop::removeTemporaryFileOnInterrupt();
   CLI::App app{"probeloop: plan, simulate and evaluate touch-probe cycles for machine-tool metrology"};
   app.require_subcommand(1);
 

@@ -1,6 +1,9 @@
 #include "core/atomic_file.hpp"
 
+#include <signal.h>
 #include <unistd.h>
+
+#include <csignal>
 
 #include <cerrno>
 #include <cstdio>
@@ -12,12 +15,49 @@
 #include "core/error.hpp"
 
 namespace probeloop {
+namespace {
+
+// The temporary file being written, for the signal handler: a fixed buffer (no allocation
+// in the handler) and a flag set only while the buffer holds a complete path.
+char g_temporary[4096];
+volatile std::sig_atomic_t g_writing = 0;
+
+extern "C" void onInterrupt(int signal) {
+  if (g_writing) ::unlink(g_temporary);  // async-signal-safe
+  std::signal(signal, SIG_DFL);
+  std::raise(signal);
+}
+
+// Marks `tmp` as the file to remove on an interrupt for the lifetime of the guard.
+class TemporaryGuard {
+ public:
+  explicit TemporaryGuard(const std::string& tmp) {
+    if (tmp.size() < sizeof g_temporary) {
+      std::memcpy(g_temporary, tmp.c_str(), tmp.size() + 1);
+      g_writing = 1;
+    }
+  }
+  ~TemporaryGuard() { g_writing = 0; }
+  TemporaryGuard(const TemporaryGuard&) = delete;
+  TemporaryGuard& operator=(const TemporaryGuard&) = delete;
+};
+
+}  // namespace
+
+void removeTemporaryFileOnInterrupt() {
+  struct sigaction action {};
+  action.sa_handler = onInterrupt;
+  sigemptyset(&action.sa_mask);
+  ::sigaction(SIGINT, &action, nullptr);
+  ::sigaction(SIGTERM, &action, nullptr);
+}
 
 void writeFileAtomic(const std::string& path, const std::string& content) {
   namespace fs = std::filesystem;
   const fs::path target(path);
   if (target.has_parent_path()) fs::create_directories(target.parent_path());
   const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+  const TemporaryGuard guard(tmp);
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) throw InputError(path, 0, std::string("cannot write: ") + std::strerror(errno));
