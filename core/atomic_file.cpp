@@ -3,6 +3,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <csignal>
 
 #include <cerrno>
@@ -32,12 +33,18 @@ extern "C" void onInterrupt(int signal) {
 class TemporaryGuard {
  public:
   explicit TemporaryGuard(const std::string& tmp) {
+    // One writer at a time (the CLI writes its files one after another, on one thread). A
+    // path too long for the buffer is not removed on an interrupt; it is still atomic.
     if (tmp.size() < sizeof g_temporary) {
       std::memcpy(g_temporary, tmp.c_str(), tmp.size() + 1);
+      std::atomic_signal_fence(std::memory_order_seq_cst);  // the path before the flag
       g_writing = 1;
     }
   }
-  ~TemporaryGuard() { g_writing = 0; }
+  ~TemporaryGuard() {
+    g_writing = 0;
+    std::atomic_signal_fence(std::memory_order_seq_cst);
+  }
   TemporaryGuard(const TemporaryGuard&) = delete;
   TemporaryGuard& operator=(const TemporaryGuard&) = delete;
 };
@@ -48,8 +55,12 @@ void removeTemporaryFileOnInterrupt() {
   struct sigaction action {};
   action.sa_handler = onInterrupt;
   sigemptyset(&action.sa_mask);
-  ::sigaction(SIGINT, &action, nullptr);
-  ::sigaction(SIGTERM, &action, nullptr);
+  for (int sig : {SIGINT, SIGTERM}) {
+    // A signal the parent ignores (a background job's SIGINT) stays ignored.
+    struct sigaction previous {};
+    if (::sigaction(sig, nullptr, &previous) == 0 && previous.sa_handler == SIG_IGN) continue;
+    ::sigaction(sig, &action, nullptr);
+  }
 }
 
 void writeFileAtomic(const std::string& path, const std::string& content) {

@@ -8,7 +8,8 @@
 //   Jacobian (not normal equations) where the conditioning needs it. Stable on short arcs
 //   (<= 10 deg), spherical caps, 4-point spheres, cylinders and cones given as partial
 //   surfaces.
-// - Degenerate input (too few points for the kind, NaN/inf, duplicated points, collinear
+// - Degenerate input (too few points for the kind, NaN/inf, duplicated points in sets up to
+//   options.duplicate_search_max_points, collinear
 //   points for a plane or circle, coplanar points for a sphere, a cap or arc too small to
 //   fix a radius, a cone with zero apex angle...) throws GeometryError saying what is wrong
 //   and what would fix it, e.g. "sphere needs >= 4 non-coplanar points; these 5 lie within

@@ -199,7 +199,7 @@ double maxDistanceFromLine(const Points3& pts, const Vector3d& c, const Vector3d
 
 // Points are hashed by their cell of a grid of kCell >> kCoincidentMm; two points within
 // kCoincidentMm share a cell unless one lies within kCoincidentMm of a cell face, and only
-// then are the neighbouring cells across that face looked at too (about 1 point in 300).
+// then are the neighbouring cells across that face looked at too (about 1 point in 100).
 // Open addressing with linear probing over a power-of-two table; an entry holds the cell's
 // 64-bit hash and the point's index, and a hit is confirmed by the distance itself.
 void checkDuplicates(ElementKind kind, const Points3& pts) {
@@ -244,8 +244,9 @@ void checkDuplicates(ElementKind kind, const Points3& pts) {
       if (v < static_cast<double>(k)) --k;  // floor without a libm call
       cell[c] = k;
       const double frac = v - static_cast<double>(k);  // cells above the lower face
-      if (frac <= kCoincidentMm * kPerMm) side[c] = -1;
-      else if (1.0 - frac <= kCoincidentMm * kPerMm) side[c] = 1;
+      // Twice the tolerance: frac is rounded, and a margin costs nothing.
+      if (frac <= 2.0 * kCoincidentMm * kPerMm) side[c] = -1;
+      else if (1.0 - frac <= 2.0 * kCoincidentMm * kPerMm) side[c] = 1;
     }
     const std::uint64_t own = keyOf(cell[0], cell[1], cell[2]);
     if (side[0] == 0 && side[1] == 0 && side[2] == 0) {

@@ -66,8 +66,10 @@ constexpr std::size_t kCoarseMin = 16 * kStartSample;
 // Convergence: dimensionless step (mm / data size, rad), relative gradient |Q^T r| / |r|.
 constexpr double kStepTol = 1e-12;
 constexpr double kGradTol = 1e-12;
-// Largest step for the contraction estimate to be trusted (asymptotic regime).
-constexpr double kContractedStep = 1e-6;
+// Largest step (as a displacement at the data's extent, mm) taken without another pass on
+// the strength of the contraction estimate: it bounds how far the residual range of the last
+// pass can be from that of the reported element.
+constexpr double kUnverifiedStepMm = 1e-8;
 // Rounding allowance of a sum of squares when comparing two of them.
 constexpr double kSsrSlack = 1e-13;
 // Largest condition number of the column-equilibrated J^T J at the solution; beyond it a
@@ -369,16 +371,17 @@ LmRun<Model> levenbergMarquardt(const Model& model, const typename Model::State&
       const double size =
           step.allFinite() ? model.stepSize(step) : std::numeric_limits<double>::infinity();
       // The last Gauss-Newton step is taken without another pass over the points when it
-      // is negligible (<= kStepTol), and on a large set (a scan) also when the iteration
-      // contracts by theta = size / previous size per step and the solution is then about
-      // theta * size <= kStepTol away (Deuflhard's a-posteriori estimate). The sum of
-      // squares moves by the step's predicted decrease |Q^T r|^2; the residual range by at
-      // most the step (size times the data size: below a picometre whenever this fires).
-      // Small sets, where a pass costs little, verify a contracted step instead (that
-      // verification is worth the last digits against NIST's reference fits).
+      // is negligible (<= kStepTol), and on a large set (a scan) also when it moves the
+      // element by at most kUnverifiedStepMm (10 pm) at the data's extent and the iteration
+      // contracts by theta = size / previous size per step so that the solution is then
+      // about theta * size <= kStepTol away (Deuflhard's a-posteriori estimate). The sum of
+      // squares moves by the step's predicted decrease |Q^T r|^2; the residual range (form)
+      // of the last pass by at most the step: below 10 pm. Small sets, where a pass costs
+      // little, verify a contracted step instead (that verification is worth the last
+      // digits against NIST's reference fits).
       if (lambda == 0.0 &&
           (size <= kStepTol ||
-           (model.count() > kDenseMax && size <= kContractedStep &&
+           (model.count() > kDenseMax && size * model.size <= kUnverifiedStepMm &&
             std::isfinite(previous_size) && size * (size / previous_size) <= kStepTol))) {
         const typename Model::State next = model.apply(run.state, step);
         if (model.valid(next)) {
@@ -451,17 +454,18 @@ Conditioning<P> conditioning(const Linearisation<P>& l) {
   return c;
 }
 
-// A converged run whose normal equations are ill-conditioned, on a set small enough for it,
-// polished with QR-solved steps from where it stopped (the result of a dense run is kept
-// only when it converged too).
+// A run whose normal equations are ill-conditioned, on a set small enough for it, polished
+// with QR-solved steps from where it stopped, within what is left of the iteration budget.
+// The polished run replaces it unless that would lose convergence.
 template <class Model>
 LmRun<Model> polished(const Model& model, LmRun<Model> run, int max_iterations) {
   if (run.lin.dense || !run.lin.ok || model.count() > kDenseMax) return run;
   if (conditioning(run.lin).condition <= kPolishCondition) return run;
-  LmRun<Model> dense = levenbergMarquardt(model, run.state, max_iterations, true);
-  if (!dense.lin.ok) return run;
+  const int left = max_iterations - run.iterations;
+  if (left < 1) return run;
+  LmRun<Model> dense = levenbergMarquardt(model, run.state, left, true);
+  if (!dense.lin.ok || (run.converged && !dense.converged)) return run;
   dense.iterations += run.iterations;
-  dense.converged = dense.converged && run.converged;
   return dense;
 }
 
