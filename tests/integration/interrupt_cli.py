@@ -47,6 +47,8 @@ def torture(name, command_for, old_dir, new_dir, kills):
     t0 = time.monotonic()
     subprocess.run(command_for(f"{W}/timing-{name}"), capture_output=True)
     duration = time.monotonic() - t0
+    # About 30 s of kills at most: a sanitizer build runs the commands 30-50x slower.
+    kills = max(8, min(kills, int(30.0 / max(duration, 1e-3) / 0.6)))
     mixed = all_new = torn = stray_int = 0
     stray_kill = []
     for i in range(kills):
