@@ -68,24 +68,28 @@ for h in "${harnesses[@]}"; do
   echo "== $h: $secs s (corpus $(ls "$scratch" | wc -l) inputs, dict fuzz/dict/$(dict_of "$h").dict)"
   # -rss_limit_mb: a reader that needs more than 2 GB for a 64 KiB input is a bug (OOM);
   # -timeout: 10 s for one input is a hang. -max_len matches the harnesses' 64 KiB cap.
+  # -max_total_time is wall time: the CPU time the harness got (user + sys, bash's `time`) is
+  # reported beside it, since a loaded machine gives a run fewer executions.
   set +e
-  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
+  TIMEFORMAT='%U %S'
+  { time ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 \
     "${nice_cmd[@]}" "build-fuzz/fuzz/${h}_fuzz" "$scratch" -dict="fuzz/dict/$(dict_of "$h").dict" \
     -max_len=65536 -timeout=10 -rss_limit_mb=2048 -max_total_time="$secs" -print_final_stats=1 \
-    -artifact_prefix="$art/" >"$log" 2>&1
+    -artifact_prefix="$art/" >"$log" 2>&1 ; } 2>"$art/cpu_seconds"
   rc=$?
   set -e
+  cpu=$(awk '{printf "%.0f", $1 + $2}' "$art/cpu_seconds" 2>/dev/null || echo "?")
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1 || true)
   cov=$(grep -oE 'cov: [0-9]+ ft: [0-9]+' "$log" | tail -1 || true)
   found=$(find "$art" -maxdepth 1 -type f \( -name 'crash-*' -o -name 'leak-*' -o -name 'timeout-*' -o -name 'oom-*' \) -newer "$stamp" | wc -l)
   [ "$rc" -ne 0 ] && status=1
-  line=$(printf '%-18s %4ss  execs %-9s %-22s corpus %5s  findings %s%s' "$h" "$secs" "${execs:-?}" "${cov:-cov: ? ft: ?}" \
+  line=$(printf '%-18s %4ss (cpu %4ss)  execs %-9s %-22s corpus %5s  findings %s%s' "$h" "$secs" "$cpu" "${execs:-?}" "${cov:-cov: ? ft: ?}" \
          "$(ls "$scratch" | wc -l)" "$found" "$([ "$rc" -ne 0 ] && echo "  (exit $rc: see $log)")")
   echo "$line"
   summary+=("$line")
   rm -rf "$scratch"
 done
 echo
-echo "== summary (seconds per harness, executions, coverage, corpus after the run, findings in out/fuzz/<harness>/)"
+echo "== summary (seconds per harness (wall, and the CPU time it got), executions, coverage, corpus after the run, findings in out/fuzz/<harness>/)"
 printf '%s\n' "${summary[@]}"
 exit $status
