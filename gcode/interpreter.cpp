@@ -1,11 +1,13 @@
 #include "gcode/interpreter.hpp"
 
 #include <cctype>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
 #include <optional>
 #include <set>
+#include <string_view>
 #include <variant>
 #include <algorithm>
 
@@ -198,7 +200,10 @@ class Execution {
     std::size_t i = 0;
     bool end() const { return i >= s.size(); }
     char peek() const { return end() ? '\0' : s[i]; }
-    bool take(const std::string& t) {
+    // Called for every operator and keyword tried at every position of every expression
+    // evaluated: the first character decides most calls without a compare.
+    bool take(std::string_view t) {
+      if (i >= s.size() || s[i] != t.front()) return false;
       if (s.compare(i, t.size(), t) == 0) {
         i += t.size();
         return true;
@@ -211,10 +216,14 @@ class Execution {
     const std::size_t b = c.i;
     while (!c.end() && (std::isdigit(static_cast<unsigned char>(c.peek())) || c.peek() == '.')) ++c.i;
     if (c.i == b) fail("expected a number at column " + std::to_string(b + 1) + " of '" + c.s + "'");
-    const std::string t = c.s.substr(b, c.i - b);
-    if (t == "." || std::count(t.begin(), t.end(), '.') > 1) fail("'" + t + "' is not a number");
-    const double v = std::strtod(t.c_str(), nullptr);
-    if (!std::isfinite(v)) fail("'" + t + "' is not a finite number");
+    const std::string_view t(c.s.data() + b, c.i - b);
+    if (t == "." || std::count(t.begin(), t.end(), '.') > 1) fail("'" + std::string(t) + "' is not a number");
+    // from_chars: correctly rounded like strtod, without the copy and the locale (every number
+    // of every expression goes through here, once per execution of its line).
+    double v = 0.0;
+    const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+    if (ec != std::errc() || end != t.data() + t.size() || !std::isfinite(v))
+      fail("'" + std::string(t) + "' is not a finite number");
     return v;
   }
 

@@ -87,6 +87,8 @@ class HeightField {
     nx_ = std::max(1, static_cast<int>(std::ceil((hi.x() - lo.x()) / cell)));
     ny_ = std::max(1, static_cast<int>(std::ceil((hi.y() - lo.y()) / cell)));
     top_.assign(static_cast<std::size_t>(nx_) * ny_, -kInf);
+    row_max_.assign(static_cast<std::size_t>(ny_), -kInf);
+    row_dirty_.assign(static_cast<std::size_t>(ny_), 1);
   }
   bool empty() const { return top_.empty(); }
   Vector2d centre(int i, int j) const { return lo_ + Vector2d((i + 0.5) * cell_, (j + 0.5) * cell_); }
@@ -97,15 +99,28 @@ class HeightField {
   double bottom() const { return bottom_; }
   double cell() const { return cell_; }
   long version() const { return version_; }
+  // Cuts only lower cells, a few rows at a time, and every distance query asks for the top:
+  // the rows a cut changed are re-scanned, not the whole field (that was most of `plan`'s
+  // time on the thermal test piece).
   double maxTop() const {
     if (dirty_) {
       max_top_ = -kInf;
-      for (double t : top_) max_top_ = std::max(max_top_, t);
+      for (int j = 0; j < ny_; ++j) {
+        if (row_dirty_[j]) {
+          double m = -kInf;
+          for (int i = 0; i < nx_; ++i) m = std::max(m, at(i, j));
+          row_max_[j] = m;
+          row_dirty_[j] = 0;
+        }
+        max_top_ = std::max(max_top_, row_max_[j]);
+      }
       dirty_ = false;
     }
     return max_top_;
   }
-  void touched() {
+  // Cells of rows j0..j1 changed.
+  void touched(int j0, int j1) {
+    for (int j = j0; j <= j1; ++j) row_dirty_[j] = 1;
     dirty_ = true;
     ++version_;
   }
@@ -170,7 +185,7 @@ class HeightField {
         t = z <= bottom_ ? -kInf : z;
         changed = true;
       }
-    if (changed) touched();
+    if (changed) touched(j0, j1);
   }
 
   // The largest distance from `axis` of material that reaches above z.
@@ -187,6 +202,8 @@ class HeightField {
   double cell_ = 0.5, bottom_ = 0;
   int nx_ = 0, ny_ = 0;
   std::vector<double> top_;
+  mutable std::vector<double> row_max_;  // largest top of each row
+  mutable std::vector<char> row_dirty_;  // rows changed since their maximum was taken
   mutable double max_top_ = -kInf;
   mutable bool dirty_ = true;
   long version_ = 0;
@@ -444,7 +461,7 @@ class Checker : public gcode::MachineInterface {
             top = std::min(top, h.z_min_mm + origin.z() <= lo.z() + 1e-9 ? -kInf : h.z_min_mm + origin.z());
         hf.at(i, j) = top;
       }
-    hf.touched();
+    hf.touched(0, hf.ny() - 1);
   }
 
   // --- geometry of a pose ---
@@ -727,8 +744,11 @@ Report checkPrograms(const std::vector<ProgramText>& programs, const parts::Mach
     const Checker::State start = ck.state();
     ck.nominal();
     bool stopped_nominal = false;
+    // Parsed once; every run (the nominal one, one per probe line with its outcome inverted)
+    // starts from a copy, with the parameters as they are before the program.
+    const gcode::Interpreter parsed(dialect, p.file, p.text);
     try {
-      gcode::Interpreter in(dialect, p.file, p.text);
+      gcode::Interpreter in = parsed;
       in.run(ck);
     } catch (const SafetyError& e) {
       stopped_nominal = true;
@@ -753,7 +773,7 @@ Report checkPrograms(const std::vector<ProgramText>& programs, const parts::Mach
       std::string went_on;
       bool stopped = false;
       try {
-        gcode::Interpreter in(dialect, p.file, p.text);
+        gcode::Interpreter in = parsed;
         in.run(ck);
         went_on = "the program's end";
       } catch (const Interrupted& i) {
