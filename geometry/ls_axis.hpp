@@ -32,6 +32,41 @@ struct AxisState {
 AxisState recentred(const Vector3d& o, const Vector3d& dir, double r, double psi,
                     const Vector3d& centroid);
 
+// Point i (and i + 1) in the frame of the current axis: q = U (p - o), its distance rho from
+// the axis and the unit radial direction (cx, cy) = (q0, q1) / rho. Shared by both models'
+// rows, so that the cylinder and the cone see the same digits.
+template <class T>
+struct RadialCoordinates {
+  T q0, q1, q2, rho, cx, cy;
+};
+template <class T>
+inline RadialCoordinates<T> radialCoordinates(const double* base, std::size_t i, const Matrix3d& u,
+                                              const Vector3d& o) {
+  const T dx = gather<T>(base, i, 3, 0) - o.x();
+  const T dy = gather<T>(base, i, 3, 1) - o.y();
+  const T dz = gather<T>(base, i, 3, 2) - o.z();
+  const T q0 = u(0, 0) * dx + u(0, 1) * dy + u(0, 2) * dz;
+  const T q1 = u(1, 0) * dx + u(1, 1) * dy + u(1, 2) * dz;
+  const T q2 = u(2, 0) * dx + u(2, 1) * dy + u(2, 2) * dz;
+  const T rho = sqrtOf(q0 * q0 + q1 * q1);
+  const T inv = reciprocal(atLeast(rho, std::numeric_limits<double>::min()));
+  return {q0, q1, q2, rho, q0 * inv, q1 * inv};
+}
+
+// The axis after the step's offsets (x0, y0) along e1, e2 and tilts (a, b) of the direction
+// (a, b, 1): the new axis point (not yet re-centred) and unit direction.
+struct SteppedAxis {
+  Vector3d o;
+  Vector3d dir;
+};
+inline SteppedAxis steppedAxis(const AxisState& s, double x0, double y0, double a, double b) {
+  const Vector3d o = s.o + x0 * s.u.row(0).transpose() + y0 * s.u.row(1).transpose();
+  const Vector3d dir =
+      (s.u.row(2).transpose() + a * s.u.row(0).transpose() + b * s.u.row(1).transpose())
+          .normalized();
+  return {o, dir};
+}
+
 // Local parameters (Forbes DITC 140/89 section 6): axis through (x0, y0, 0) of the frame,
 // direction (a, b, 1) normalised, radius r (and half angle psi for the cone). In the frame,
 // q = U (p - o), rho = |(q0, q1)|:
@@ -57,15 +92,7 @@ struct CylinderModel {
   Pre prepare(const State& s) const { return {pts->front().data(), s.u, s.o, s.r}; }
   template <class T>
   void row(const Pre& p, std::size_t i, std::array<T, P + 1>& v) const {
-    const T dx = gather<T>(p.base, i, 3, 0) - p.o.x();
-    const T dy = gather<T>(p.base, i, 3, 1) - p.o.y();
-    const T dz = gather<T>(p.base, i, 3, 2) - p.o.z();
-    const T q0 = p.u(0, 0) * dx + p.u(0, 1) * dy + p.u(0, 2) * dz;
-    const T q1 = p.u(1, 0) * dx + p.u(1, 1) * dy + p.u(1, 2) * dz;
-    const T q2 = p.u(2, 0) * dx + p.u(2, 1) * dy + p.u(2, 2) * dz;
-    const T rho = sqrtOf(q0 * q0 + q1 * q1);
-    const T inv = reciprocal(atLeast(rho, std::numeric_limits<double>::min()));
-    const T cx = q0 * inv, cy = q1 * inv;
+    const auto [q0, q1, q2, rho, cx, cy] = radialCoordinates<T>(p.base, i, p.u, p.o);
     v[0] = -cx;
     v[1] = -cy;
     v[2] = -cx * q2;
@@ -74,10 +101,7 @@ struct CylinderModel {
     v[P] = rho - p.r;
   }
   State apply(const State& s, const Vec<P>& d) const {
-    const Vector3d o = s.o + d(0) * s.u.row(0).transpose() + d(1) * s.u.row(1).transpose();
-    const Vector3d dir = (s.u.row(2).transpose() + d(2) * s.u.row(0).transpose() +
-                          d(3) * s.u.row(1).transpose())
-                             .normalized();
+    const auto [o, dir] = steppedAxis(s, d(0), d(1), d(2), d(3));
     double r = s.r;
     if constexpr (!Fixed) r += d(4);
     return recentred(o, dir, r, 0.0, centroid);
@@ -109,15 +133,7 @@ struct ConeModel {
   }
   template <class T>
   void row(const Pre& p, std::size_t i, std::array<T, P + 1>& v) const {
-    const T dx = gather<T>(p.base, i, 3, 0) - p.o.x();
-    const T dy = gather<T>(p.base, i, 3, 1) - p.o.y();
-    const T dz = gather<T>(p.base, i, 3, 2) - p.o.z();
-    const T q0 = p.u(0, 0) * dx + p.u(0, 1) * dy + p.u(0, 2) * dz;
-    const T q1 = p.u(1, 0) * dx + p.u(1, 1) * dy + p.u(1, 2) * dz;
-    const T q2 = p.u(2, 0) * dx + p.u(2, 1) * dy + p.u(2, 2) * dz;
-    const T rho = sqrtOf(q0 * q0 + q1 * q1);
-    const T inv = reciprocal(atLeast(rho, std::numeric_limits<double>::min()));
-    const T cx = q0 * inv, cy = q1 * inv;
+    const auto [q0, q1, q2, rho, cx, cy] = radialCoordinates<T>(p.base, i, p.u, p.o);
     const T tilt = q2 * p.c;
     v[0] = -cx * p.c;
     v[1] = -cy * p.c;
@@ -128,10 +144,7 @@ struct ConeModel {
     v[P] = (rho - p.r) * p.c - q2 * p.s;
   }
   State apply(const State& s, const Vec<P>& d) const {
-    const Vector3d o = s.o + d(0) * s.u.row(0).transpose() + d(1) * s.u.row(1).transpose();
-    const Vector3d dir = (s.u.row(2).transpose() + d(2) * s.u.row(0).transpose() +
-                          d(3) * s.u.row(1).transpose())
-                             .normalized();
+    const auto [o, dir] = steppedAxis(s, d(0), d(1), d(2), d(3));
     return recentred(o, dir, s.r + d(4), s.psi + d(5), centroid);
   }
   double stepSize(const Vec<P>& d) const {
