@@ -31,6 +31,10 @@ const char* ttpRouteName(TtpRoute r) {
 
 namespace {
 
+// Largest point number a file may give (a feature has tens of points; the bound keeps the
+// conversion to int defined).
+constexpr int kMaxPointNumber = 1000000;
+
 // ".csv" at the end of the path, in any case.
 bool csvExtension(const std::string& path) {
   static const std::string ext = ".csv";
@@ -305,7 +309,9 @@ TtpPoints readTtpCmmExport(const std::string& path, const std::string& text, con
     for (std::size_t i = 0; i < out.points.size(); ++i) {
       auto& p = out.points[i];
       const double k = t.number(t.rows[i], cp);
-      if (k != std::round(k) || k < 1) throw InputError(path, p.line, "point must be a positive integer");
+      // Bounded before the conversion to int (7e61 was undefined behaviour: fuzz/ttp_cmm_csv).
+      if (k != std::round(k) || k < 1 || k > kMaxPointNumber)
+        throw InputError(path, p.line, "point must be a positive integer up to " + std::to_string(kMaxPointNumber));
       p.point = static_cast<int>(k);
       const auto key = std::make_pair(p.feature, p.point);
       if (seen.count(key))
@@ -353,7 +359,8 @@ TtpPoints readTtpOnMachine(const std::string& path, const std::string& text, con
         throw InputError(path, row.line, "feature '" + f + "': expected P<position> or a feature id of the manifest " + m.file);
       }
       const double k = t.number(row, cp);
-      if (k != std::round(k) || k < 1) throw InputError(path, row.line, "point must be a positive integer");
+      if (k != std::round(k) || k < 1 || k > kMaxPointNumber)
+        throw InputError(path, row.line, "point must be a positive integer up to " + std::to_string(kMaxPointNumber));
       r.point = static_cast<int>(k);
       r.tip = Vector3d(t.number(row, cx), t.number(row, cy), t.number(row, cz));
       if (cc >= 0) r.c_deg = t.number(row, cc);
