@@ -222,6 +222,13 @@ class Execution {
     // of every expression goes through here, once per execution of its line).
     double v = 0.0;
     const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+    if (ec == std::errc::result_out_of_range) {
+      // Below the smallest double (0.000...1 with hundreds of zeros): 0, as strtod reads it.
+      // Anything with a non-zero digit before the point is above the largest.
+      const std::string_view whole = t.substr(0, t.find('.'));
+      if (whole.find_first_not_of('0') == std::string_view::npos) return 0.0;
+      fail("'" + std::string(t) + "' is too large for a number");
+    }
     if (ec != std::errc() || end != t.data() + t.size() || !std::isfinite(v))
       fail("'" + std::string(t) + "' is not a finite number");
     return v;

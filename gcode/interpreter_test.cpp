@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <numbers>
 
 #include "core/error.hpp"
@@ -244,6 +245,27 @@ TEST(Interpreter, RefusesWhatItDoesNotModelWithTheLine) {
   expectInputError(ProgramDialect::FanucMacroB, "M98 P1000\n", "bad.ngc:1: subprogram calls");
   expectInputError(ProgramDialect::FanucMacroB, "G38.2 X1. F100\n", "bad.ngc:1: G38.2 is not modelled");
   expectInputError(ProgramDialect::FanucMacroB, "GOTO 5\n", "bad.ngc:1: GOTO 5: no block N5");
+}
+
+// Numbers read exactly as strtod reads them: "5." and ".5", a subnormal, a value below the
+// smallest double (0, as strtod has it), 600 significant digits; one above the largest is an
+// error with the line.
+TEST(Interpreter, NumbersReadAsStrtodReadsThem) {
+  Recorder r;
+  const std::string tiny = "0." + std::string(400, '0') + "1";
+  const std::string subnormal = "0." + std::string(309, '0') + "1";  // 1e-310
+  const std::string long_digits = "1." + std::string(300, '3') + std::string(300, '7');
+  Interpreter in(ProgramDialect::LinuxCnc, "t.ngc",
+                 "#1 = 5.\n#2 = .5\n#3 = " + tiny + "\n#4 = " + subnormal + "\n#5 = " + long_digits +
+                     "\n#6 = 000012.250\nM2\n");
+  in.run(r);
+  EXPECT_EQ(in.parameter(1), 5.0);
+  EXPECT_EQ(in.parameter(2), 0.5);
+  EXPECT_EQ(in.parameter(3), 0.0);
+  EXPECT_EQ(in.parameter(4), std::strtod(subnormal.c_str(), nullptr));
+  EXPECT_EQ(in.parameter(5), std::strtod(long_digits.c_str(), nullptr));
+  EXPECT_EQ(in.parameter(6), 12.25);
+  expectInputError(ProgramDialect::LinuxCnc, "#1 = " + std::string(400, '9') + "\n", "bad.ngc:1: '999");
 }
 
 // Found by fuzz/gcode_linuxcnc_fuzz: thousands of nested brackets exhausted the stack.

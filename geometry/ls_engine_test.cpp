@@ -198,7 +198,8 @@ TEST(LeastSquaresEngine, ScanReachesTheOptimum) {
   const FitResult fit = fitLeastSquares(ElementKind::Sphere, p, o);
   Vector3d c(412.5, -233.25, 118.0);
   double r = 25.0;
-  for (int it = 0; it < 50; ++it) {
+  bool converged = false;
+  for (int it = 0; it < 50 && !converged; ++it) {
     Eigen::Matrix<L, 4, 4> a = Eigen::Matrix<L, 4, 4>::Zero();
     Eigen::Matrix<L, 4, 1> b = Eigen::Matrix<L, 4, 1>::Zero();
     for (const auto& q : p) {
@@ -213,21 +214,24 @@ TEST(LeastSquaresEngine, ScanReachesTheOptimum) {
     c += Vector3d(static_cast<double>(step(0)), static_cast<double>(step(1)),
                   static_cast<double>(step(2)));
     r += static_cast<double>(step(3));
-    if (step.cwiseAbs().maxCoeff() < 1e-13) break;
+    converged = step.cwiseAbs().maxCoeff() < 1e-13;
   }
+  ASSERT_TRUE(converged);
   EXPECT_LT((fit.element.position_mm - c).norm(), 1e-10);
   EXPECT_LT(std::abs(fit.element.radius_mm - r), 1e-10);
 
   const Points3 q = noisyPoints(ElementKind::Cylinder, 200000, 6);
   const FitResult cyl = fitLeastSquares(ElementKind::Cylinder, q, o);
   V3 axis_point(412.5L, -233.25L, 118.0L), u(0.0L, 0.0L, 1.0L);
-  L radius = 20.0L;
-  for (int it = 0; it < 50; ++it) {
+  L radius = 20.0L, ssr = 0.0L;
+  converged = false;
+  for (int it = 0; it < 50 && !converged; ++it) {
     // Any two unit vectors perpendicular to u.
     const V3 e1 = (std::abs(u.x()) < 0.9L ? V3(1, 0, 0) : V3(0, 1, 0)).cross(u).normalized();
     const V3 e2 = u.cross(e1);
     Eigen::Matrix<L, 5, 5> a = Eigen::Matrix<L, 5, 5>::Zero();
     Eigen::Matrix<L, 5, 1> b = Eigen::Matrix<L, 5, 1>::Zero();
+    ssr = 0.0L;
     for (const auto& pt : q) {
       const V3 w = pt.cast<L>() - axis_point;
       const V3 v = w - w.dot(u) * u;
@@ -238,18 +242,21 @@ TEST(LeastSquaresEngine, ScanReachesTheOptimum) {
       j << -n.dot(e1), -n.dot(e2), -along * n.dot(e1), -along * n.dot(e2), -1.0L;
       a += j * j.transpose();
       b += j * (rho - radius);
+      ssr += (rho - radius) * (rho - radius);
     }
     const Eigen::Matrix<L, 5, 1> step = -a.ldlt().solve(b);
     axis_point += step(0) * e1 + step(1) * e2;
     u = (u + step(2) * e1 + step(3) * e2).normalized();
     radius += step(4);
-    if (step.cwiseAbs().maxCoeff() < 1e-13L) break;
+    converged = step.cwiseAbs().maxCoeff() < 1e-13L;  // ssr: at the last state but one
   }
+  ASSERT_TRUE(converged);
   const Vector3d d = u.cast<double>();
   const Vector3d off = cyl.element.position_mm - axis_point.cast<double>();
   EXPECT_LT((off - d * d.dot(off)).norm(), 1e-9);  // the axes pass within 1 pm of each other
   EXPECT_LT(std::abs(cyl.element.radius_mm - static_cast<double>(radius)), 1e-9);
   EXPECT_LT(std::min((cyl.element.direction - d).norm(), (cyl.element.direction + d).norm()), 1e-10);
+  EXPECT_NEAR(cyl.ssr_mm2, static_cast<double>(ssr), 1e-9 * static_cast<double>(ssr));
 
   // From a start 0.3 mm and 10 mrad away, the same optimum.
   LeastSquaresOptions poor = o;
@@ -264,4 +271,5 @@ TEST(LeastSquaresEngine, ScanReachesTheOptimum) {
   EXPECT_LT(std::abs(from_poor.element.radius_mm - static_cast<double>(radius)), 1e-9);
   EXPECT_LT(std::min((from_poor.element.direction - d).norm(), (from_poor.element.direction + d).norm()),
             1e-10);
+  EXPECT_NEAR(from_poor.ssr_mm2, static_cast<double>(ssr), 1e-9 * static_cast<double>(ssr));
 }

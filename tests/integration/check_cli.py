@@ -57,7 +57,7 @@ for machine in ("nmv5000", "linuxcnc_rotary_mill"):
         plans.append(("ttp", machine, dialect, None))
 for machine in ("vmc3", "nmv5000", "linuxcnc_rotary_mill"):
     for dialect in ("linuxcnc", "fanuc"):
-        for k in ((2, 8) if os.environ.get("CHECK_QUICK") else range(1, 9)):
+        for k in ((2, 8) if os.environ.get("CHECK_QUICK") == "1" else range(1, 9)):
             plans.append(("sw", machine, dialect, f"W{k}"))
 dirs = {}
 for piece, machine, dialect, exp in plans:
