@@ -162,6 +162,28 @@ using Lanes = Eigen::Array2d;
 template <class T>
 constexpr std::size_t kWidth = std::is_same_v<T, Lanes> ? 2 : 1;
 
+// Four points in the four lanes of a GCC vector: one AVX register in the AVX2 clone of the
+// pass (accumulate), two SSE2 registers in the default one. Every operation is IEEE per lane
+// in both (the square root is SSE2's on each half, no FMA), so the sums, and the fits, are
+// the same to the last bit whichever clone the CPU runs.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"  // 32-byte vectors by value: inlined, never an ABI
+using Quad = double __attribute__((vector_size(32)));
+using QuadHalf = double __attribute__((vector_size(16)));
+inline Quad sqrtOf(Quad x) {
+  const QuadHalf lo = __builtin_ia32_sqrtpd(QuadHalf{x[0], x[1]});
+  const QuadHalf hi = __builtin_ia32_sqrtpd(QuadHalf{x[2], x[3]});
+  return Quad{lo[0], lo[1], hi[0], hi[1]};
+}
+inline Quad atLeast(Quad x, double floor) {
+  const Quad f = {floor, floor, floor, floor};
+  return x > f ? x : f;  // maxpd's rule, as Lanes::max
+}
+inline Quad reciprocal(Quad x) { return 1.0 / x; }
+inline Quad lowerOf(Quad a, Quad b) { return a < b ? a : b; }
+inline Quad higherOf(Quad a, Quad b) { return a > b ? a : b; }
+
+
 inline double sqrtOf(double x) { return std::sqrt(x); }
 inline Lanes sqrtOf(const Lanes& x) { return x.sqrt(); }
 inline double atLeast(double x, double floor) { return std::max(x, floor); }
@@ -170,16 +192,21 @@ inline double reciprocal(double x) { return 1.0 / x; }
 inline Lanes reciprocal(const Lanes& x) { return x.inverse(); }
 template <class T>
 inline T constant(double x) {
-  if constexpr (std::is_same_v<T, Lanes>)
+  if constexpr (std::is_same_v<T, Quad>)
+    return Quad{x, x, x, x};
+  else if constexpr (std::is_same_v<T, Lanes>)
     return Lanes::Constant(x);
   else
     return x;
 }
 
-// Coordinate c of point i (and i + 1) of points stored as `stride` doubles each.
+// Coordinate c of point i (and the next ones) of points stored as `stride` doubles each.
 template <class T>
 inline T gather(const double* base, std::size_t i, std::size_t stride, int c) {
-  if constexpr (std::is_same_v<T, Lanes>)
+  if constexpr (std::is_same_v<T, Quad>)
+    return Quad{base[i * stride + c], base[(i + 1) * stride + c], base[(i + 2) * stride + c],
+                base[(i + 3) * stride + c]};
+  else if constexpr (std::is_same_v<T, Lanes>)
     return Lanes(base[i * stride + c], base[(i + 1) * stride + c]);
   else
     return base[i * stride + c];
@@ -217,27 +244,31 @@ inline void addProducts(std::array<T, NormalSums<P>::K>& acc, const std::array<T
   }
 }
 
-// One pass: the model's rows at state s, summed in blocks.
+// One pass: the model's rows at state s, summed in blocks, four points at a time. Cloned for
+// AVX2 (chosen at load time by the CPU): the 15-28 running sums of [J r]^T [J r] are what
+// the pass spends its time on, and AVX2 halves their instructions (docs/performance.md).
 template <class Model>
+__attribute__((target_clones("avx2", "default")))
 NormalSums<Model::P> accumulate(const Model& model, const typename Model::State& s) {
   constexpr int P = Model::P;
   constexpr int K = NormalSums<P>::K;
   const auto pre = model.prepare(s);
   const std::size_t n = model.count();
   NormalSums<P> out;
-  Lanes lo = Lanes::Constant(std::numeric_limits<double>::infinity());
-  Lanes hi = -lo;
+  const double inf = std::numeric_limits<double>::infinity();
+  Quad lo = {inf, inf, inf, inf};
+  Quad hi = -lo;
   for (std::size_t b0 = 0; b0 < n; b0 += kBlock) {
     const std::size_t b1 = std::min(n, b0 + kBlock);
-    std::array<Lanes, K> acc;
-    acc.fill(Lanes::Zero());
+    std::array<Quad, K> acc;
+    acc.fill(Quad{0.0, 0.0, 0.0, 0.0});
     std::size_t i = b0;
-    for (; i + 2 <= b1; i += 2) {
-      std::array<Lanes, P + 1> v;
-      model.template row<Lanes>(pre, i, v);
+    for (; i + 4 <= b1; i += 4) {
+      std::array<Quad, P + 1> v;
+      model.template row<Quad>(pre, i, v);
       addProducts<P>(acc, v);
-      lo = lo.min(v[P]);
-      hi = hi.max(v[P]);
+      lo = lowerOf(lo, v[P]);
+      hi = higherOf(hi, v[P]);
     }
     std::array<double, K> tail{};
     for (; i < b1; ++i) {
@@ -247,12 +278,14 @@ NormalSums<Model::P> accumulate(const Model& model, const typename Model::State&
       out.rmin = std::min(out.rmin, v[P]);
       out.rmax = std::max(out.rmax, v[P]);
     }
-    for (int k = 0; k < K; ++k) out.s[k] += (acc[k](0) + acc[k](1)) + tail[k];
+    for (int k = 0; k < K; ++k)
+      out.s[k] += ((acc[k][0] + acc[k][1]) + (acc[k][2] + acc[k][3])) + tail[k];
   }
-  out.rmin = std::min({out.rmin, lo(0), lo(1)});
-  out.rmax = std::max({out.rmax, hi(0), hi(1)});
+  out.rmin = std::min({out.rmin, lo[0], lo[1], lo[2], lo[3]});
+  out.rmax = std::max({out.rmax, hi[0], hi[1], hi[2], hi[3]});
   return out;
 }
+#pragma GCC diagnostic pop
 
 // Cholesky of the accumulated J^T J.
 template <int P>
