@@ -74,28 +74,29 @@ void checkCount(ElementKind kind, const Points3& pts) {
 
 namespace {
 
-// One pass: sums of d and d d^T, d = p - shift, two points per register, in blocks of
-// kBlock partial sums.
+// One pass: sums of d and d d^T, d = p - shift, four points per vector (Quad, cloned for
+// AVX2 like the fits' passes: the same sums on every CPU), in blocks of kBlock partial sums.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
 template <bool Planar>
-Moments momentsAbout(const Points3& pts, const Vector3d& shift) {
+__attribute__((target_clones("avx2", "default")))
+std::array<double, 9> momentSums(const Points3& pts, const Vector3d& shift) {
   const std::size_t n = pts.size();
   const double* base = pts.front().data();
   std::array<double, 9> t{};  // x y z xx xy xz yy yz zz
   for (std::size_t b0 = 0; b0 < n; b0 += kBlock) {
     const std::size_t b1 = std::min(n, b0 + kBlock);
-    Lanes sx = Lanes::Zero(), sy = sx, sz = sx, sxx = sx, sxy = sx, sxz = sx, syy = sx,
-          syz = sx, szz = sx;
+    const Quad zero = {0.0, 0.0, 0.0, 0.0};
+    Quad sx = zero, sy = zero, sz = zero, sxx = zero, sxy = zero, sxz = zero, syy = zero,
+         syz = zero, szz = zero;
     std::size_t i = b0;
-    auto add = [&](auto x, auto y, auto z) {
+    for (; i + 4 <= b1; i += 4) {
+      const Quad x = gather<Quad>(base, i, 3, 0) - shift.x();
+      const Quad y = gather<Quad>(base, i, 3, 1) - shift.y();
+      const Quad z = Planar ? zero : gather<Quad>(base, i, 3, 2) - shift.z();
       sx += x, sy += y, sz += z;
       sxx += x * x, sxy += x * y, sxz += x * z;
       syy += y * y, syz += y * z, szz += z * z;
-    };
-    for (; i + 2 <= b1; i += 2) {
-      const Lanes x = gather<Lanes>(base, i, 3, 0) - shift.x();
-      const Lanes y = gather<Lanes>(base, i, 3, 1) - shift.y();
-      const Lanes z = Planar ? Lanes::Zero() : Lanes(gather<Lanes>(base, i, 3, 2) - shift.z());
-      add(x, y, z);
     }
     double tail[9] = {};
     for (; i < b1; ++i) {
@@ -104,9 +105,17 @@ Moments momentsAbout(const Points3& pts, const Vector3d& shift) {
       const double v[9] = {x, y, z, x * x, x * y, x * z, y * y, y * z, z * z};
       for (int k = 0; k < 9; ++k) tail[k] += v[k];
     }
-    const Lanes* lanes[9] = {&sx, &sy, &sz, &sxx, &sxy, &sxz, &syy, &syz, &szz};
-    for (int k = 0; k < 9; ++k) t[k] += ((*lanes[k])(0) + (*lanes[k])(1)) + tail[k];
+    const Quad* q[9] = {&sx, &sy, &sz, &sxx, &sxy, &sxz, &syy, &syz, &szz};
+    for (int k = 0; k < 9; ++k) t[k] += (((*q[k])[0] + (*q[k])[1]) + ((*q[k])[2] + (*q[k])[3])) + tail[k];
   }
+  return t;
+}
+#pragma GCC diagnostic pop
+
+template <bool Planar>
+Moments momentsAbout(const Points3& pts, const Vector3d& shift) {
+  const std::size_t n = pts.size();
+  const std::array<double, 9> t = momentSums<Planar>(pts, shift);
   Moments m;
   m.n = n;
   const double inv = 1.0 / static_cast<double>(n);
