@@ -5,10 +5,16 @@
 //
 // The engine's pass over the points (why it is fast and still accurate):
 // - Each model gives one row per point: J_i = d r_i / d(local parameters) and r_i, the signed
-//   orthogonal distance, from a kernel written once for a scalar and for a pair of points
-//   in one SSE2 register (Lanes). One pass accumulates the upper triangle of [J r]^T [J r]
+//   orthogonal distance, from a kernel written once for a scalar and for four points in a
+//   GCC vector (Quad). One pass accumulates the upper triangle of [J r]^T [J r]
 //   (J^T J, J^T r and the sum of squares) and the residual range, in partial sums of
-//   kBlock rows (rounding grows like (B + n / B) eps instead of n eps).
+//   kBlock rows (rounding grows like (B + n / B) eps instead of n eps). The pass is cloned
+//   for AVX2 (one register per Quad) and SSE2 (two), with the same IEEE operations per lane,
+//   so the fits are bit-identical on either CPU.
+// - On scans (more than kDenseMax points), once the steps are small, a Gauss-Newton trial
+//   state is evaluated by a chord pass: J^T J kept from the last full pass, only J^T r, the
+//   sum of squares and the range summed (accumulateGradient). The running sums of J^T J are
+//   what a full pass spends its time on; the fixed point J^T r = 0 is the same.
 // - The step is solved from the Cholesky factor of J^T J (R = L^T, Q^T r = L^-1 J^T r).
 //   The fixed point J^T r = 0 does not depend on the solve; only the rate does. When the
 //   equilibrated J^T J is ill-conditioned (short arcs, small caps, partial cylinders) and the
