@@ -79,7 +79,7 @@ namespace {
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"
 template <bool Planar>
-__attribute__((target_clones("avx2", "default")))
+PROBELOOP_CLONED_FOR_AVX2
 std::array<double, 9> momentSums(const Points3& pts, const Vector3d& shift) {
   const std::size_t n = pts.size();
   const double* base = pts.front().data();
