@@ -78,7 +78,8 @@ for h in "${harnesses[@]}"; do
     -artifact_prefix="$art/" >"$log" 2>&1 ; } 2>"$art/cpu_seconds"
   rc=$?
   set -e
-  cpu=$(awk '{printf "%.0f", $1 + $2}' "$art/cpu_seconds" 2>/dev/null || echo "?")
+  # The last line: a harness killed by a signal puts bash's notice before it.
+  cpu=$(awk 'END {printf "%.0f", $1 + $2}' "$art/cpu_seconds" 2>/dev/null || echo "?")
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1 || true)
   cov=$(grep -oE 'cov: [0-9]+ ft: [0-9]+' "$log" | tail -1 || true)
   found=$(find "$art" -maxdepth 1 -type f \( -name 'crash-*' -o -name 'leak-*' -o -name 'timeout-*' -o -name 'oom-*' \) -newer "$stamp" | wc -l)
