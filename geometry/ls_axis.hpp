@@ -40,7 +40,7 @@ struct RadialCoordinates {
   T q0, q1, q2, rho, cx, cy;
 };
 template <class T>
-inline RadialCoordinates<T> radialCoordinates(const double* base, std::size_t i, const Matrix3d& u,
+[[gnu::always_inline]] inline RadialCoordinates<T> radialCoordinates(const double* base, std::size_t i, const Matrix3d& u,
                                               const Vector3d& o) {
   const T dx = gather<T>(base, i, 3, 0) - o.x();
   const T dy = gather<T>(base, i, 3, 1) - o.y();
@@ -51,6 +51,12 @@ inline RadialCoordinates<T> radialCoordinates(const double* base, std::size_t i,
   const T rho = sqrtOf(q0 * q0 + q1 * q1);
   const T inv = reciprocal(atLeast(rho, std::numeric_limits<double>::min()));
   return {q0, q1, q2, rho, q0 * inv, q1 * inv};
+}
+
+// Whether two states' frames are the same up to a small turn (the chord passes reuse J^T J
+// only then): frameOf turns e1, e2 by 90 degrees or more when the axis crosses the xy plane.
+inline bool axisFramesAgree(const AxisState& a, const AxisState& b) {
+  return a.u.row(0).dot(b.u.row(0)) > 0.999 && a.u.row(1).dot(b.u.row(1)) > 0.999;
 }
 
 // The axis after the step's offsets (x0, y0) along e1, e2 and tilts (a, b) of the direction
@@ -91,7 +97,7 @@ struct CylinderModel {
   std::size_t count() const { return pts->size(); }
   Pre prepare(const State& s) const { return {pts->front().data(), s.u, s.o, s.r}; }
   template <class T>
-  void row(const Pre& p, std::size_t i, std::array<T, P + 1>& v) const {
+  [[gnu::always_inline]] void row(const Pre& p, std::size_t i, std::array<T, P + 1>& v) const {
     const auto [q0, q1, q2, rho, cx, cy] = radialCoordinates<T>(p.base, i, p.u, p.o);
     v[0] = -cx;
     v[1] = -cy;
@@ -112,6 +118,7 @@ struct CylinderModel {
     return std::max(lengths / size, std::max(std::abs(d(2)), std::abs(d(3))));
   }
   bool valid(const State& s) const { return s.o.allFinite() && s.u.allFinite() && s.r > 0.0; }
+  bool sameFrame(const State& a, const State& b) const { return axisFramesAgree(a, b); }
 };
 
 struct ConeModel {
@@ -132,7 +139,7 @@ struct ConeModel {
     return {pts->front().data(), s.u, s.o, s.r, std::cos(s.psi), std::sin(s.psi)};
   }
   template <class T>
-  void row(const Pre& p, std::size_t i, std::array<T, P + 1>& v) const {
+  [[gnu::always_inline]] void row(const Pre& p, std::size_t i, std::array<T, P + 1>& v) const {
     const auto [q0, q1, q2, rho, cx, cy] = radialCoordinates<T>(p.base, i, p.u, p.o);
     const T tilt = q2 * p.c;
     v[0] = -cx * p.c;
@@ -151,6 +158,7 @@ struct ConeModel {
     const double lengths = std::max({std::abs(d(0)), std::abs(d(1)), std::abs(d(4))});
     return std::max(lengths / size, std::max({std::abs(d(2)), std::abs(d(3)), std::abs(d(5))}));
   }
+  bool sameFrame(const State& a, const State& b) const { return axisFramesAgree(a, b); }
   bool valid(const State& s) const {
     return s.o.allFinite() && s.u.allFinite() && std::isfinite(s.r) &&
            std::abs(s.psi) < 0.5 * kPi - 1e-6;

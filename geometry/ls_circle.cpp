@@ -29,7 +29,7 @@ struct CircleModel {
   std::size_t count() const { return q->size(); }
   Pre prepare(const State& s) const { return {q->front().data(), s.c, s.r}; }
   template <class T>
-  void row(const Pre& p, std::size_t i, std::array<T, P + 1>& v) const {
+  [[gnu::always_inline]] void row(const Pre& p, std::size_t i, std::array<T, P + 1>& v) const {
     const T x = gather<T>(p.base, i, 2, 0) - p.c.x();
     const T y = gather<T>(p.base, i, 2, 1) - p.c.y();
     const T rho = sqrtOf(x * x + y * y);

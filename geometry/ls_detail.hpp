@@ -177,7 +177,11 @@ constexpr std::size_t kWidth = std::is_same_v<T, Lanes> ? 2 : 1;
 // in both (the square root is SSE2's on each half, no FMA), so the sums, and the fits, are
 // the same to the last bit whichever clone the CPU runs.
 #pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wpsabi"  // 32-byte vectors by value: inlined, never an ABI
+// A function taking or returning a Quad by value has a different calling convention in the
+// AVX2 clone (ymm registers) than in default code (memory): every such helper is
+// always_inline (also at -O0), so no call ever crosses that boundary; gcc's -Wpsabi note
+// about it is silenced.
+#pragma GCC diagnostic ignored "-Wpsabi"
 // gcc clones function templates; clang (the fuzz build only) does not yet, and gets the SSE2
 // version alone, with the same results.
 #if defined(__clang__)
@@ -187,18 +191,18 @@ constexpr std::size_t kWidth = std::is_same_v<T, Lanes> ? 2 : 1;
 #endif
 using Quad = double __attribute__((vector_size(32)));
 using QuadHalf = double __attribute__((vector_size(16)));
-inline Quad sqrtOf(Quad x) {
+[[gnu::always_inline]] inline Quad sqrtOf(Quad x) {
   const QuadHalf lo = __builtin_ia32_sqrtpd(QuadHalf{x[0], x[1]});
   const QuadHalf hi = __builtin_ia32_sqrtpd(QuadHalf{x[2], x[3]});
   return Quad{lo[0], lo[1], hi[0], hi[1]};
 }
-inline Quad atLeast(Quad x, double floor) {
+[[gnu::always_inline]] inline Quad atLeast(Quad x, double floor) {
   const Quad f = {floor, floor, floor, floor};
-  return x > f ? x : f;  // maxpd's rule, as Lanes::max
+  return x > f ? x : f;  // a NaN gives the floor; its residual still makes the sums NaN
 }
-inline Quad reciprocal(Quad x) { return 1.0 / x; }
-inline Quad lowerOf(Quad a, Quad b) { return a < b ? a : b; }
-inline Quad higherOf(Quad a, Quad b) { return a > b ? a : b; }
+[[gnu::always_inline]] inline Quad reciprocal(Quad x) { return 1.0 / x; }
+[[gnu::always_inline]] inline Quad lowerOf(Quad a, Quad b) { return a < b ? a : b; }
+[[gnu::always_inline]] inline Quad higherOf(Quad a, Quad b) { return a > b ? a : b; }
 
 
 inline double sqrtOf(double x) { return std::sqrt(x); }
@@ -208,7 +212,7 @@ inline Lanes atLeast(const Lanes& x, double floor) { return x.max(floor); }
 inline double reciprocal(double x) { return 1.0 / x; }
 inline Lanes reciprocal(const Lanes& x) { return x.inverse(); }
 template <class T>
-inline T constant(double x) {
+[[gnu::always_inline]] inline T constant(double x) {
   if constexpr (std::is_same_v<T, Quad>)
     return Quad{x, x, x, x};
   else if constexpr (std::is_same_v<T, Lanes>)
@@ -219,7 +223,7 @@ inline T constant(double x) {
 
 // Coordinate c of point i (and the next ones) of points stored as `stride` doubles each.
 template <class T>
-inline T gather(const double* base, std::size_t i, std::size_t stride, int c) {
+[[gnu::always_inline]] inline T gather(const double* base, std::size_t i, std::size_t stride, int c) {
   if constexpr (std::is_same_v<T, Quad>)
     return Quad{base[i * stride + c], base[(i + 1) * stride + c], base[(i + 2) * stride + c],
                 base[(i + 3) * stride + c]};
@@ -240,38 +244,60 @@ struct Linearisation {
   double rmin = 0.0, rmax = 0.0;  // residual range
   bool ok = false;
   bool dense = false;  // R from QR of J itself
+  bool chord = false;  // R kept from an earlier state (chordLinearisation)
 };
 
-// Upper triangle of [J r]^T [J r] in row-major order, and the residual range.
-template <int P>
-struct NormalSums {
-  static constexpr int K = (P + 1) * (P + 2) / 2;
+// Sums of a pass over the rows [J_i r_i], and the residual range.
+template <int K>
+struct RowSums {
   std::array<double, K> s{};
   double rmin = std::numeric_limits<double>::infinity();
   double rmax = -std::numeric_limits<double>::infinity();
 };
 
-template <int P, class T>
-inline void addProducts(std::array<T, NormalSums<P>::K>& acc, const std::array<T, P + 1>& v) {
-  int k = 0;
+// What a full pass sums per row: the upper triangle of [J r]^T [J r] in row-major order.
+template <int P>
+struct AllProducts {
+  static constexpr int K = (P + 1) * (P + 2) / 2;
+  template <class T>
+  static void add(std::array<T, K>& acc, const std::array<T, P + 1>& v) {
+    int k = 0;
 #pragma GCC unroll 8
-  for (int a = 0; a <= P; ++a) {
+    for (int a = 0; a <= P; ++a) {
 #pragma GCC unroll 8
-    for (int b = a; b <= P; ++b) acc[k++] += v[a] * v[b];
+      for (int b = a; b <= P; ++b) acc[k++] += v[a] * v[b];
+    }
   }
-}
+};
+
+// What a chord pass sums per row: J^T r and r^T r, the last column of [J r]^T [J r]. With
+// P + 1 running sums instead of (P + 1)(P + 2) / 2 it costs a third of a full pass.
+template <int P>
+struct GradientProducts {
+  static constexpr int K = P + 1;
+  template <class T>
+  static void add(std::array<T, K>& acc, const std::array<T, P + 1>& v) {
+#pragma GCC unroll 8
+    for (int a = 0; a <= P; ++a) acc[a] += v[a] * v[P];
+  }
+};
+
+template <int P>
+using NormalSums = RowSums<AllProducts<P>::K>;
+template <int P>
+using GradientSums = RowSums<GradientProducts<P>::K>;
 
 // One pass: the model's rows at state s, summed in blocks, four points at a time. Cloned for
 // AVX2 (chosen at load time by the CPU): the 15-28 running sums of [J r]^T [J r] are what
 // the pass spends its time on, and AVX2 halves their instructions (docs/performance.md).
-template <class Model>
+template <class Products, class Model>
 PROBELOOP_CLONED_FOR_AVX2
-NormalSums<Model::P> accumulate(const Model& model, const typename Model::State& s) {
+RowSums<Products::K> sumRows(const Model& model, const typename Model::State& s) {
   constexpr int P = Model::P;
-  constexpr int K = NormalSums<P>::K;
+  constexpr int K = Products::K;
   const auto pre = model.prepare(s);
   const std::size_t n = model.count();
-  NormalSums<P> out;
+  RowSums<K> out;
   const double inf = std::numeric_limits<double>::infinity();
   Quad lo = {inf, inf, inf, inf};
   Quad hi = -lo;
@@ -283,7 +309,7 @@ NormalSums<Model::P> accumulate(const Model& model, const typename Model::State&
     for (; i + 4 <= b1; i += 4) {
       std::array<Quad, P + 1> v;
       model.template row<Quad>(pre, i, v);
-      addProducts<P>(acc, v);
+      Products::add(acc, v);
       lo = lowerOf(lo, v[P]);
       hi = higherOf(hi, v[P]);
     }
@@ -291,7 +317,7 @@ NormalSums<Model::P> accumulate(const Model& model, const typename Model::State&
     for (; i < b1; ++i) {
       std::array<double, P + 1> v;
       model.template row<double>(pre, i, v);
-      addProducts<P>(tail, v);
+      Products::add(tail, v);
       out.rmin = std::min(out.rmin, v[P]);
       out.rmax = std::max(out.rmax, v[P]);
     }
@@ -303,53 +329,14 @@ NormalSums<Model::P> accumulate(const Model& model, const typename Model::State&
   return out;
 }
 
-// J^T r and r^T r (the last column of [J r]^T [J r]) and the residual range.
-template <int P>
-struct GradientSums {
-  std::array<double, P + 1> s{};
-  double rmin = std::numeric_limits<double>::infinity();
-  double rmax = -std::numeric_limits<double>::infinity();
-};
-
-// The chord pass: the rows at state s, only J^T r, r^T r and the range summed. With P + 1
-// running sums instead of (P + 1)(P + 2) / 2 it costs a third of accumulate().
+// The full pass and the chord pass.
 template <class Model>
-PROBELOOP_CLONED_FOR_AVX2
+NormalSums<Model::P> accumulate(const Model& model, const typename Model::State& s) {
+  return sumRows<AllProducts<Model::P>>(model, s);
+}
+template <class Model>
 GradientSums<Model::P> accumulateGradient(const Model& model, const typename Model::State& s) {
-  constexpr int P = Model::P;
-  const auto pre = model.prepare(s);
-  const std::size_t n = model.count();
-  GradientSums<P> out;
-  const double inf = std::numeric_limits<double>::infinity();
-  Quad lo = {inf, inf, inf, inf};
-  Quad hi = -lo;
-  for (std::size_t b0 = 0; b0 < n; b0 += kBlock) {
-    const std::size_t b1 = std::min(n, b0 + kBlock);
-    std::array<Quad, P + 1> acc;
-    acc.fill(Quad{0.0, 0.0, 0.0, 0.0});
-    std::size_t i = b0;
-    for (; i + 4 <= b1; i += 4) {
-      std::array<Quad, P + 1> v;
-      model.template row<Quad>(pre, i, v);
-#pragma GCC unroll 8
-      for (int a = 0; a <= P; ++a) acc[a] += v[a] * v[P];
-      lo = lowerOf(lo, v[P]);
-      hi = higherOf(hi, v[P]);
-    }
-    std::array<double, P + 1> tail{};
-    for (; i < b1; ++i) {
-      std::array<double, P + 1> v;
-      model.template row<double>(pre, i, v);
-      for (int a = 0; a <= P; ++a) tail[a] += v[a] * v[P];
-      out.rmin = std::min(out.rmin, v[P]);
-      out.rmax = std::max(out.rmax, v[P]);
-    }
-    for (int a = 0; a <= P; ++a)
-      out.s[a] += ((acc[a][0] + acc[a][1]) + (acc[a][2] + acc[a][3])) + tail[a];
-  }
-  out.rmin = std::min({out.rmin, lo[0], lo[1], lo[2], lo[3]});
-  out.rmax = std::max({out.rmax, hi[0], hi[1], hi[2], hi[3]});
-  return out;
+  return sumRows<GradientProducts<Model::P>>(model, s);
 }
 #pragma GCC diagnostic pop
 
@@ -435,7 +422,20 @@ Linearisation<Model::P> chordLinearisation(const Model& model, const typename Mo
   out.rmin = g.rmin;
   out.rmax = g.rmax;
   out.ok = base.ok && out.qtr.allFinite() && std::isfinite(out.ssr);
+  out.chord = true;
   return out;
+}
+
+// Whether J^T J at `base` still describes the parameters at `next`: the axis models'
+// parameters live in a frame rebuilt every step, which turns by 90 degrees or more when the
+// axis crosses the xy plane (frameOf); the others have fixed parameters.
+template <class Model>
+bool sameParameters(const Model& model, const typename Model::State& base,
+                    const typename Model::State& next) {
+  if constexpr (requires { model.sameFrame(base, next); })
+    return model.sameFrame(base, next);
+  else
+    return true;
 }
 
 template <int P>
@@ -479,6 +479,7 @@ LmRun<Model> levenbergMarquardt(const Model& model, const typename Model::State&
   double lambda = 0.0;
   double previous_size = std::numeric_limits<double>::infinity();
   double since_full = 0.0;  // sum of the steps since run.lin's J^T J was summed
+  typename Model::State full_at = start;  // where it was summed
   while (run.iterations < max_iterations) {
     ++run.iterations;
     if (run.lin.qtr.norm() <= kGradTol * std::sqrt(run.lin.ssr)) {
@@ -515,7 +516,7 @@ LmRun<Model> levenbergMarquardt(const Model& model, const typename Model::State&
         const typename Model::State next = model.apply(run.state, step);
         if (model.valid(next)) {
           const bool chord = !dense && lambda == 0.0 && model.count() > kDenseMax &&
-                             since_full + size <= kChordStep;
+                             since_full + size <= kChordStep && sameParameters(model, full_at, next);
           const Linearisation<P> l =
               chord ? chordLinearisation(model, next, run.lin) : linearise(model, next, dense);
           // Ties within the rounding of the sum of squares are accepted: close to the
@@ -529,16 +530,26 @@ LmRun<Model> levenbergMarquardt(const Model& model, const typename Model::State&
           if (l.ok && l.ssr <= run.lin.ssr + slack) {
             const bool gauss_newton = lambda == 0.0;
             const bool insignificant = run.lin.ssr - l.ssr <= slack;
+            const bool step_from_chord = run.lin.chord;
             run.state = next;
             run.lin = l;
             since_full = chord ? since_full + size : 0.0;
+            if (!chord) full_at = next;
             scale = scale.cwiseMax(columnNorms(l.R));
             lambda = lambda < 1e-8 ? 0.0 : 0.1 * lambda;
             accepted = true;
             // Converged when the step is negligible, or when Gauss-Newton steps no longer
             // shrink while the sum of squares no longer changes: the rounding floor.
-            if (size <= kStepTol || (gauss_newton && insignificant && size > 0.5 * previous_size))
+            // A chord step that did not halve says J^T J is stale, not that the floor is
+            // reached: the next trial gets a full pass.
+            if (size <= kStepTol)
               run.converged = true;
+            else if (gauss_newton && insignificant && size > 0.5 * previous_size) {
+              if (step_from_chord)
+                since_full = std::numeric_limits<double>::infinity();
+              else
+                run.converged = true;
+            }
             previous_size = gauss_newton ? size : std::numeric_limits<double>::infinity();
             break;
           }

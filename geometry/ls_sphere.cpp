@@ -26,7 +26,7 @@ struct SphereModel {
   std::size_t count() const { return pts->size(); }
   Pre prepare(const State& s) const { return {pts->front().data(), s.c, s.r}; }
   template <class T>
-  void row(const Pre& p, std::size_t i, std::array<T, P + 1>& v) const {
+  [[gnu::always_inline]] void row(const Pre& p, std::size_t i, std::array<T, P + 1>& v) const {
     const T x = gather<T>(p.base, i, 3, 0) - p.c.x();
     const T y = gather<T>(p.base, i, 3, 1) - p.c.y();
     const T z = gather<T>(p.base, i, 3, 2) - p.c.z();
