@@ -48,8 +48,7 @@ template <class T>
   const T q0 = u(0, 0) * dx + u(0, 1) * dy + u(0, 2) * dz;
   const T q1 = u(1, 0) * dx + u(1, 1) * dy + u(1, 2) * dz;
   const T q2 = u(2, 0) * dx + u(2, 1) * dy + u(2, 2) * dz;
-  const T rho = sqrtOf(q0 * q0 + q1 * q1);
-  const T inv = reciprocal(atLeast(rho, std::numeric_limits<double>::min()));
+  const auto [rho, inv] = lengthAndInverse<T>(q0 * q0 + q1 * q1);
   return {q0, q1, q2, rho, q0 * inv, q1 * inv};
 }
 

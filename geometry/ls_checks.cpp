@@ -74,13 +74,14 @@ void checkCount(ElementKind kind, const Points3& pts) {
 
 namespace {
 
-// One pass: sums of d and d d^T, d = p - shift, four points per vector (Quad, cloned for
-// AVX2 like the fits' passes: the same sums on every CPU), in blocks of kBlock partial sums.
+// One pass: sums of d and d d^T, d = p - shift, four points per vector (in an AVX2 and a
+// default version, like the fits' passes: the same sums on every CPU), in blocks of kBlock
+// partial sums.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"
 template <bool Planar>
-PROBELOOP_CLONED_FOR_AVX2
-std::array<double, 9> momentSums(const Points3& pts, const Vector3d& shift) {
+[[gnu::always_inline]] inline std::array<double, 9> momentSumsWith(const Points3& pts,
+                                                                   const Vector3d& shift) {
   const std::size_t n = pts.size();
   const double* base = pts.front().data();
   std::array<double, 9> t{};  // x y z xx xy xz yy yz zz
@@ -109,6 +110,15 @@ std::array<double, 9> momentSums(const Points3& pts, const Vector3d& shift) {
     for (int k = 0; k < 9; ++k) t[k] += (((*q[k])[0] + (*q[k])[1]) + ((*q[k])[2] + (*q[k])[3])) + tail[k];
   }
   return t;
+}
+template <bool Planar>
+[[gnu::target("avx2")]] std::array<double, 9> momentSumsAvx2(const Points3& pts,
+                                                              const Vector3d& shift) {
+  return momentSumsWith<Planar>(pts, shift);
+}
+template <bool Planar>
+std::array<double, 9> momentSums(const Points3& pts, const Vector3d& shift) {
+  return useAvx2Passes() ? momentSumsAvx2<Planar>(pts, shift) : momentSumsWith<Planar>(pts, shift);
 }
 #pragma GCC diagnostic pop
 

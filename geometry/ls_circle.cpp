@@ -32,8 +32,7 @@ struct CircleModel {
   [[gnu::always_inline]] void row(const Pre& p, std::size_t i, std::array<T, P + 1>& v) const {
     const T x = gather<T>(p.base, i, 2, 0) - p.c.x();
     const T y = gather<T>(p.base, i, 2, 1) - p.c.y();
-    const T rho = sqrtOf(x * x + y * y);
-    const T inv = reciprocal(atLeast(rho, std::numeric_limits<double>::min()));
+    const auto [rho, inv] = lengthAndInverse<T>(x * x + y * y);
     v[0] = -x * inv;
     v[1] = -y * inv;
     if constexpr (!Fixed) v[2] = constant<T>(-1.0);

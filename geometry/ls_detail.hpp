@@ -8,9 +8,11 @@
 //   orthogonal distance, from a kernel written once for a scalar and for four points in a
 //   GCC vector (Quad). One pass accumulates the upper triangle of [J r]^T [J r]
 //   (J^T J, J^T r and the sum of squares) and the residual range, in partial sums of
-//   kBlock rows (rounding grows like (B + n / B) eps instead of n eps). The pass is cloned
-//   for AVX2 (one register per Quad) and SSE2 (two), with the same IEEE operations per lane,
-//   so the fits are bit-identical on either CPU.
+//   kBlock rows (rounding grows like (B + n / B) eps instead of n eps). The pass exists for
+//   AVX2 (one register per Quad) and SSE2 (two), chosen at run time, with the same IEEE
+//   operations per lane, so the fits are bit-identical on either CPU. The row kernels
+//   take |v| and 1 / |v| as |v| / |v|^2, and the pass computes the next row before it adds
+//   this one's products: both keep the square root's latency off the critical path.
 // - On scans (more than kDenseMax points), once the steps are small, a Gauss-Newton trial
 //   state is evaluated by a chord pass: J^T J kept from the last full pass, only J^T r, the
 //   sum of squares and the range summed (accumulateGradient). The running sums of J^T J are
@@ -30,6 +32,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -166,29 +169,29 @@ V knownRadiusCentre(const V& mean, double s2, const V& free_centre, double radiu
 // ---------------------------------------------------------------------------------------
 // Row kernels: scalar or two points at once
 
-// Two points in the two lanes of one SSE2 register. Every operation is IEEE per lane, so
-// the sums do not depend on the instruction set the compiler picks.
-using Lanes = Eigen::Array2d;
-template <class T>
-constexpr std::size_t kWidth = std::is_same_v<T, Lanes> ? 2 : 1;
+// The passes over the points (the fits' rows, the moments, the plane's residuals) run four
+// points at a time, in one of two versions chosen at run time: for CPUs with AVX2 (compiled
+// with [[gnu::target("avx2")]], a Quad in one ymm register) and for the others (two SSE2
+// registers). Both do the same IEEE operations per lane in the same order, with no FMA
+// (-ffp-contract=off for this library), so a fit is the same to the last bit on either CPU;
+// ls_engine_test compares them.
+//
+// Whether the AVX2 versions run: the CPU has AVX2 and the default versions were not asked for
+// (defaultPassesOnly, for the tests).
+inline std::atomic<bool> defaultPassesOnly{false};
+inline bool useAvx2Passes() {
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2 && !defaultPassesOnly.load(std::memory_order_relaxed);
+}
 
-// Four points in the four lanes of a GCC vector: one AVX register in the AVX2 clone of the
-// pass (accumulate), two SSE2 registers in the default one. Every operation is IEEE per lane
-// in both (the square root is SSE2's on each half, no FMA), so the sums, and the fits, are
-// the same to the last bit whichever clone the CPU runs.
+// Four points in the four lanes of a GCC vector: two SSE2 registers in the default pass, one
+// AVX register in the AVX2 pass (as Ymm below).
 #pragma GCC diagnostic push
-// A function taking or returning a Quad by value has a different calling convention in the
-// AVX2 clone (ymm registers) than in default code (memory): every such helper is
+// A function taking or returning a Quad (or Ymm) by value has a different calling convention
+// in AVX2 code (ymm registers) than in default code (memory): every such helper is
 // always_inline (also at -O0), so no call ever crosses that boundary; gcc's -Wpsabi note
 // about it is silenced.
 #pragma GCC diagnostic ignored "-Wpsabi"
-// gcc clones function templates; clang (the fuzz build only) does not yet, and gets the SSE2
-// version alone, with the same results.
-#if defined(__clang__)
-#define PROBELOOP_CLONED_FOR_AVX2
-#else
-#define PROBELOOP_CLONED_FOR_AVX2 __attribute__((target_clones("avx2", "default")))
-#endif
 using Quad = double __attribute__((vector_size(32)));
 using QuadHalf = double __attribute__((vector_size(16)));
 [[gnu::always_inline]] inline Quad sqrtOf(Quad x) {
@@ -204,33 +207,80 @@ using QuadHalf = double __attribute__((vector_size(16)));
 [[gnu::always_inline]] inline Quad lowerOf(Quad a, Quad b) { return a < b ? a : b; }
 [[gnu::always_inline]] inline Quad higherOf(Quad a, Quad b) { return a > b ? a : b; }
 
+// A Quad as the lane type of the AVX2 pass: a type of its own so that the row kernels,
+// written once for any lane type, take its four square roots with one 256-bit vsqrtpd. Two
+// 128-bit sqrtpd take twice its time on the AVX2 cores measured (docs/performance.md), and
+// the compiler does not merge them. A square root is correctly rounded either way, and every
+// other operation is Quad's, so the two passes give the same bits.
+struct Ymm {
+  Quad v;
+  [[gnu::always_inline]] double operator[](int k) const { return v[k]; }
+  [[gnu::always_inline]] Ymm& operator+=(Ymm o) {
+    v += o.v;
+    return *this;
+  }
+};
+[[gnu::always_inline]] inline Ymm operator-(Ymm a) { return {-a.v}; }
+[[gnu::always_inline]] inline Ymm operator+(Ymm a, Ymm b) { return {a.v + b.v}; }
+[[gnu::always_inline]] inline Ymm operator-(Ymm a, Ymm b) { return {a.v - b.v}; }
+[[gnu::always_inline]] inline Ymm operator*(Ymm a, Ymm b) { return {a.v * b.v}; }
+[[gnu::always_inline]] inline Ymm operator-(Ymm a, double b) { return {a.v - b}; }
+[[gnu::always_inline]] inline Ymm operator*(Ymm a, double b) { return {a.v * b}; }
+[[gnu::always_inline]] inline Ymm operator*(double a, Ymm b) { return {a * b.v}; }
+[[gnu::always_inline]] inline Ymm sqrtOf(Ymm x) {
+#if defined(__clang__)
+  return {sqrtOf(x.v)};  // clang checks the constraint before inlining; same bits
+#else
+  // Only ever inlined into the AVX2 pass (everything on the way is always_inline), where a
+  // Ymm lives in one ymm register.
+  const Quad in = x.v;
+  Quad out;
+  asm("vsqrtpd %1, %0" : "=x"(out) : "x"(in));
+  return {out};
+#endif
+}
+[[gnu::always_inline]] inline Ymm atLeast(Ymm x, double floor) { return {atLeast(x.v, floor)}; }
+[[gnu::always_inline]] inline Ymm reciprocal(Ymm x) { return {1.0 / x.v}; }
+[[gnu::always_inline]] inline Ymm lowerOf(Ymm a, Ymm b) { return {lowerOf(a.v, b.v)}; }
+[[gnu::always_inline]] inline Ymm higherOf(Ymm a, Ymm b) { return {higherOf(a.v, b.v)}; }
 
 inline double sqrtOf(double x) { return std::sqrt(x); }
-inline Lanes sqrtOf(const Lanes& x) { return x.sqrt(); }
 inline double atLeast(double x, double floor) { return std::max(x, floor); }
-inline Lanes atLeast(const Lanes& x, double floor) { return x.max(floor); }
 inline double reciprocal(double x) { return 1.0 / x; }
-inline Lanes reciprocal(const Lanes& x) { return x.inverse(); }
 template <class T>
 [[gnu::always_inline]] inline T constant(double x) {
   if constexpr (std::is_same_v<T, Quad>)
     return Quad{x, x, x, x};
-  else if constexpr (std::is_same_v<T, Lanes>)
-    return Lanes::Constant(x);
+  else if constexpr (std::is_same_v<T, Ymm>)
+    return Ymm{Quad{x, x, x, x}};
   else
     return x;
 }
 
-// Coordinate c of point i (and the next ones) of points stored as `stride` doubles each.
+// Coordinate c of point i (and the next three for a Quad or Ymm) of points stored as `stride`
+// doubles each.
 template <class T>
 [[gnu::always_inline]] inline T gather(const double* base, std::size_t i, std::size_t stride, int c) {
   if constexpr (std::is_same_v<T, Quad>)
     return Quad{base[i * stride + c], base[(i + 1) * stride + c], base[(i + 2) * stride + c],
                 base[(i + 3) * stride + c]};
-  else if constexpr (std::is_same_v<T, Lanes>)
-    return Lanes(base[i * stride + c], base[(i + 1) * stride + c]);
+  else if constexpr (std::is_same_v<T, Ymm>)
+    return Ymm{gather<Quad>(base, i, stride, c)};
   else
     return base[i * stride + c];
+}
+
+// |v| and 1 / |v| from |v|^2, as |v| / |v|^2: the square root and the division do not wait
+// for each other (1 / sqrt(s) chains them), which is what bounded the row kernels' time.
+// A zero length gives 1 / |v| = 0, so its Jacobian row is 0, not NaN.
+template <class T>
+struct LengthAndInverse {
+  T length, inverse;
+};
+template <class T>
+[[gnu::always_inline]] inline LengthAndInverse<T> lengthAndInverse(T squared) {
+  const T length = sqrtOf(squared);
+  return {length, length * reciprocal(atLeast(squared, std::numeric_limits<double>::min()))};
 }
 
 // ---------------------------------------------------------------------------------------
@@ -260,7 +310,7 @@ template <int P>
 struct AllProducts {
   static constexpr int K = (P + 1) * (P + 2) / 2;
   template <class T>
-  static void add(std::array<T, K>& acc, const std::array<T, P + 1>& v) {
+  [[gnu::always_inline]] static void add(std::array<T, K>& acc, const std::array<T, P + 1>& v) {
     int k = 0;
 #pragma GCC unroll 8
     for (int a = 0; a <= P; ++a) {
@@ -276,7 +326,7 @@ template <int P>
 struct GradientProducts {
   static constexpr int K = P + 1;
   template <class T>
-  static void add(std::array<T, K>& acc, const std::array<T, P + 1>& v) {
+  [[gnu::always_inline]] static void add(std::array<T, K>& acc, const std::array<T, P + 1>& v) {
 #pragma GCC unroll 8
     for (int a = 0; a <= P; ++a) acc[a] += v[a] * v[P];
   }
@@ -287,28 +337,38 @@ using NormalSums = RowSums<AllProducts<P>::K>;
 template <int P>
 using GradientSums = RowSums<GradientProducts<P>::K>;
 
-// One pass: the model's rows at state s, summed in blocks, four points at a time. Cloned for
-// AVX2 (chosen at load time by the CPU): the 15-28 running sums of [J r]^T [J r] are what
-// the pass spends its time on, and AVX2 halves their instructions (docs/performance.md).
-template <class Products, class Model>
-PROBELOOP_CLONED_FOR_AVX2
-RowSums<Products::K> sumRows(const Model& model, const typename Model::State& s) {
+// One pass: the model's rows at state s, summed in blocks, four points at a time (T = Quad
+// or Ymm).
+template <class T, class Products, class Model>
+[[gnu::always_inline]] inline RowSums<Products::K> sumRowsWith(const Model& model,
+                                                               const typename Model::State& s) {
   constexpr int P = Model::P;
   constexpr int K = Products::K;
   const auto pre = model.prepare(s);
   const std::size_t n = model.count();
   RowSums<K> out;
   const double inf = std::numeric_limits<double>::infinity();
-  Quad lo = {inf, inf, inf, inf};
-  Quad hi = -lo;
+  T lo = constant<T>(inf);
+  T hi = constant<T>(-inf);
   for (std::size_t b0 = 0; b0 < n; b0 += kBlock) {
     const std::size_t b1 = std::min(n, b0 + kBlock);
-    std::array<Quad, K> acc;
-    acc.fill(Quad{0.0, 0.0, 0.0, 0.0});
+    std::array<T, K> acc;
+    acc.fill(constant<T>(0.0));
     std::size_t i = b0;
-    for (; i + 4 <= b1; i += 4) {
-      std::array<Quad, P + 1> v;
-      model.template row<Quad>(pre, i, v);
+    // Software-pipelined by one row of four: the next row's square root is issued before this
+    // row's products, so its latency overlaps them (12 % off a full cylinder pass). The sums
+    // are taken in the same order as without it.
+    if (i + 4 <= b1) {
+      std::array<T, P + 1> v;
+      model.template row<T>(pre, i, v);
+      for (i += 4; i + 4 <= b1; i += 4) {
+        std::array<T, P + 1> next;
+        model.template row<T>(pre, i, next);
+        Products::add(acc, v);
+        lo = lowerOf(lo, v[P]);
+        hi = higherOf(hi, v[P]);
+        v = next;
+      }
       Products::add(acc, v);
       lo = lowerOf(lo, v[P]);
       hi = higherOf(hi, v[P]);
@@ -327,6 +387,22 @@ RowSums<Products::K> sumRows(const Model& model, const typename Model::State& s)
   out.rmin = std::min({out.rmin, lo[0], lo[1], lo[2], lo[3]});
   out.rmax = std::max({out.rmax, hi[0], hi[1], hi[2], hi[3]});
   return out;
+}
+
+// The two versions of the pass. The 15-28 running sums of [J r]^T [J r] and the square roots
+// are what it spends its time on, and AVX2 halves their instructions (docs/performance.md).
+template <class Products, class Model>
+[[gnu::target("avx2")]] RowSums<Products::K> sumRowsAvx2(const Model& model,
+                                                         const typename Model::State& s) {
+  return sumRowsWith<Ymm, Products>(model, s);
+}
+template <class Products, class Model>
+RowSums<Products::K> sumRowsDefault(const Model& model, const typename Model::State& s) {
+  return sumRowsWith<Quad, Products>(model, s);
+}
+template <class Products, class Model>
+RowSums<Products::K> sumRows(const Model& model, const typename Model::State& s) {
+  return useAvx2Passes() ? sumRowsAvx2<Products>(model, s) : sumRowsDefault<Products>(model, s);
 }
 
 // The full pass and the chord pass.

@@ -30,8 +30,7 @@ struct SphereModel {
     const T x = gather<T>(p.base, i, 3, 0) - p.c.x();
     const T y = gather<T>(p.base, i, 3, 1) - p.c.y();
     const T z = gather<T>(p.base, i, 3, 2) - p.c.z();
-    const T rho = sqrtOf(x * x + y * y + z * z);
-    const T inv = reciprocal(atLeast(rho, std::numeric_limits<double>::min()));
+    const auto [rho, inv] = lengthAndInverse<T>(x * x + y * y + z * z);
     v[0] = -x * inv;
     v[1] = -y * inv;
     v[2] = -z * inv;
