@@ -79,9 +79,8 @@ constexpr double kGradTol = 1e-12;
 // the strength of the contraction estimate: it bounds how far the residual range of the last
 // pass can be from that of the reported element.
 constexpr double kUnverifiedStepMm = 1e-8;
-// On a scan, a Gauss-Newton trial state is evaluated by a chord pass (J^T J kept, only J^T r
-// summed) while the steps since the last full pass add up to at most this (dimensionless,
-// as kStepTol): J^T J has then changed by about as little, and so has the rate.
+// Chord passes (chordLinearisation) are taken while the steps since the last full pass add up
+// to at most this (dimensionless, as kStepTol): J^T J has then changed by about as little.
 constexpr double kChordStep = 1e-4;
 // Rounding allowance of a sum of squares when comparing two of them.
 constexpr double kSsrSlack = 1e-13;
@@ -180,7 +179,10 @@ V knownRadiusCentre(const V& mean, double s2, const V& free_centre, double radiu
 // (defaultPassesOnly, for the tests).
 inline std::atomic<bool> defaultPassesOnly{false};
 inline bool useAvx2Passes() {
-  static const bool avx2 = __builtin_cpu_supports("avx2");
+  static const bool avx2 = [] {
+    __builtin_cpu_init();  // in case the first fit runs in a static constructor
+    return __builtin_cpu_supports("avx2") != 0;
+  }();
   return avx2 && !defaultPassesOnly.load(std::memory_order_relaxed);
 }
 
