@@ -32,7 +32,7 @@ struct AxisState {
 AxisState recentred(const Vector3d& o, const Vector3d& dir, double r, double psi,
                     const Vector3d& centroid);
 
-// Point i (and i + 1) in the frame of the current axis: q = U (p - o), its distance rho from
+// Point i (or i..i + 3) in the frame of the current axis: q = U (p - o), its distance rho from
 // the axis and the unit radial direction (cx, cy) = (q0, q1) / rho. Shared by both models'
 // rows, so that the cylinder and the cone see the same digits.
 template <class T>

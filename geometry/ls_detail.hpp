@@ -166,7 +166,7 @@ V knownRadiusCentre(const V& mean, double s2, const V& free_centre, double radiu
 }
 
 // ---------------------------------------------------------------------------------------
-// Row kernels: scalar or two points at once
+// Row kernels: one point (double) or four (Quad, Ymm) at once
 
 // The passes over the points (the fits' rows, the moments, the plane's residuals) run four
 // points at a time, in one of two versions chosen at run time: for CPUs with AVX2 (compiled
@@ -237,7 +237,7 @@ struct Ymm {
   // Ymm lives in one ymm register.
   const Quad in = x.v;
   Quad out;
-  asm("vsqrtpd %1, %0" : "=x"(out) : "x"(in));
+  asm("vsqrtpd {%1, %0|%0, %1}" : "=x"(out) : "x"(in));  // AT&T | Intel syntax
   return {out};
 #endif
 }
@@ -274,7 +274,9 @@ template <class T>
 
 // |v| and 1 / |v| from |v|^2, as |v| / |v|^2: the square root and the division do not wait
 // for each other (1 / sqrt(s) chains them), which is what bounded the row kernels' time.
-// A zero length gives 1 / |v| = 0, so its Jacobian row is 0, not NaN.
+// A zero length gives 1 / |v| = 0, so its Jacobian row is 0, not NaN. Below |v| = 1.5e-154 mm
+// (|v|^2 under the smallest normal double) 1 / |v| comes out too small by |v|^2 / DBL_MIN;
+// a point that close to a centre or an axis has no direction to give anyway.
 template <class T>
 struct LengthAndInverse {
   T length, inverse;
