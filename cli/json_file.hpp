@@ -9,11 +9,13 @@
 namespace probeloop::cli {
 
 inline nlohmann::json readJsonFile(const std::string& path) {
-  const std::string text = readFile(path);
+  const std::string text = readFile(path, kJsonInput);
   try {
     return nlohmann::json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
-    throw InputError(path, 0, std::string("not valid JSON (") + e.what() + ")");
+    const std::string kind = describeContent(text);
+    throw InputError(path, 0, std::string("not valid JSON (") + e.what() + ")" +
+                                  (kind.empty() || kind.find("JSON") != std::string::npos ? "" : "; the file looks like " + kind));
   }
 }
 

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <unistd.h>
 
+#include "cli/input_option.hpp"
 #include "cli/model_commands.hpp"
 #include "cli/report_commands.hpp"
 #include "cli/json_file.hpp"
@@ -133,7 +134,7 @@ int cmdCheck(const std::vector<std::string>& program_files, const std::string& m
     const auto machine = parts::loadMachine(machine_file);
     const auto piece = parts::loadTestPiece(part_file);
     std::vector<verify::ProgramText> texts;
-    for (const auto& f : program_files) texts.push_back({f, readFile(f)});
+    for (const auto& f : program_files) texts.push_back({f, readFile(f, kProgramInput)});
     const auto r = verify::checkPrograms(texts, machine, piece);
     if (json) {
       std::fputs(verify::reportJson(r).c_str(), stdout);
@@ -194,7 +195,7 @@ int cmdSimulate(const std::vector<std::string>& program_files, const std::string
   }
   part.trace = trace;
   std::vector<sim::ProgramSource> programs;
-  for (const auto& f : program_files) programs.push_back({f, readFile(f), std::nullopt});
+  for (const auto& f : program_files) programs.push_back({f, readFile(f, kProgramInput), std::nullopt});
   if (!schedule_file.empty()) {
     // Each program starts at its planned time; the machine is off in between.
     const auto m = parts::readManifest(schedule_file);
@@ -391,8 +392,8 @@ int main(int argc, char** argv) {
   bool free_radius = false;
 
   auto* plan = app.add_subcommand("plan", "Programs (G-code) and the plan manifest for a test piece: sphere artifact, thermal test piece, stepped workpiece");
-  plan->add_option("piece", artifact, "test-piece description (YAML, kind: sphere_artifact | thermal_test_piece | stepped_workpiece)")->required()->check(CLI::ExistingFile);
-  plan->add_option("--machine", machine, "machine description (YAML)")->required()->check(CLI::ExistingFile);
+  plan->add_option("piece", artifact, "test-piece description (YAML, kind: sphere_artifact | thermal_test_piece | stepped_workpiece)")->required()->check(cli::inputFile());
+  plan->add_option("--machine", machine, "machine description (YAML)")->required()->check(cli::inputFile());
   plan->add_option("--out", out, "output folder")->capture_default_str();
   plan->add_option("--dialect", dialect, "machine (from the machine file), linuxcnc or fanuc")
       ->check(CLI::IsMember({"machine", "linuxcnc", "fanuc"}))->capture_default_str();
@@ -401,25 +402,25 @@ int main(int argc, char** argv) {
   std::string predict_from;
   plan->add_option("--predict-from", predict_from, "stepped workpiece: another part's evaluation.json; its separated components, "
                    "fitted against feed and Temp state, predict this experiment's wall and floor errors, which the finishing "
-                   "path takes out (seed 000 Ch. 6)")->check(CLI::ExistingFile);
+                   "path takes out (seed 000 Ch. 6)")->check(cli::inputFile());
   plan->add_option("--compensate", compensate, "stepped workpiece: compensation.json (from evaluate): the predicted wall and "
-                   "floor errors taken out of the finishing path (seed 000 Ch. 6)")->check(CLI::ExistingFile);
+                   "floor errors taken out of the finishing path (seed 000 Ch. 6)")->check(cli::inputFile());
 
   std::string read_file;
   bool read_json = false;
   auto* rd = app.add_subcommand("read", "What probeloop reads in a CMM exchange file (QIF 3.0 Results or Plan, DMIS output or "
                                 "program): features, points, units");
-  rd->add_option("file", read_file, "QIF 3.0 or DMIS file")->required()->check(CLI::ExistingFile);
+  rd->add_option("file", read_file, "QIF 3.0 or DMIS file")->required()->check(cli::inputFile());
   rd->add_flag("--json", read_json, "print JSON (every feature with its geometry and points, in mm)");
 
   auto* res = app.add_subcommand("resolution", "Resolution of the location errors (seed 004 Table 5.4)");
-  res->add_option("artifact", artifact, "sphere artifact description (YAML)")->required()->check(CLI::ExistingFile);
-  res->add_option("--machine", machine, "machine description (YAML)")->required()->check(CLI::ExistingFile);
+  res->add_option("artifact", artifact, "sphere artifact description (YAML)")->required()->check(cli::inputFile());
+  res->add_option("--machine", machine, "machine description (YAML)")->required()->check(cli::inputFile());
   res->add_option("--step-um", step_um, "coordinate step, um")->capture_default_str()->check(CLI::PositiveNumber);
 
   auto* syn = app.add_subcommand("synth", "Test generator: logs of a campaign with known rigid-body C-axis errors");
-  syn->add_option("manifest", manifest, "plan manifest (plan.json)")->required()->check(CLI::ExistingFile);
-  syn->add_option("--truth", truth, "truth description (YAML)")->required()->check(CLI::ExistingFile);
+  syn->add_option("manifest", manifest, "plan manifest (plan.json)")->required()->check(cli::inputFile());
+  syn->add_option("--truth", truth, "truth description (YAML)")->required()->check(cli::inputFile());
   syn->add_option("--out", out, "output folder")->capture_default_str();
   syn->add_option("--seed", seed, "random seed")->capture_default_str();
 
@@ -427,36 +428,36 @@ int main(int argc, char** argv) {
   std::string part;
   auto* simc = app.add_subcommand("simulate", "Run emitted programs, one after the other, on a virtual machine with known error effects");
   simc->add_option("programs", sim_programs, "G-code programs (.ngc LinuxCNC, .nc Fanuc macro B), run back to back")
-      ->required()->check(CLI::ExistingFile);
-  simc->add_option("--machine", machine, "machine description (YAML)")->required()->check(CLI::ExistingFile);
+      ->required()->check(cli::inputFile());
+  simc->add_option("--machine", machine, "machine description (YAML)")->required()->check(cli::inputFile());
   std::string cmm_points;
   bool sim_trace = false;
-  simc->add_option("--part", part, "what stands on the table: a sphere artifact, a thermal test piece or a workpiece (YAML)")->required()->check(CLI::ExistingFile);
-  simc->add_option("--truth", truth, "the machine's error effects (YAML, kind: machine_truth)")->required()->check(CLI::ExistingFile);
+  simc->add_option("--part", part, "what stands on the table: a sphere artifact, a thermal test piece or a workpiece (YAML)")->required()->check(cli::inputFile());
+  simc->add_option("--truth", truth, "the machine's error effects (YAML, kind: machine_truth)")->required()->check(cli::inputFile());
   simc->add_option("--out", out, "output folder")->capture_default_str();
   simc->add_option("--seed", seed, "random seed")->capture_default_str();
   simc->add_option("--cmm-points", cmm_points, "machined part: CMM points to measure after the programs "
-                   "(feature,point,x_mm,y_mm,z_mm,nx,ny,nz; or a QIF 3.0 plan or a DMIS program: then cmm_results.qif and .dmo too)")->check(CLI::ExistingFile);
+                   "(feature,point,x_mm,y_mm,z_mm,nx,ny,nz; or a QIF 3.0 plan or a DMIS program: then cmm_results.qif and .dmo too)")->check(cli::inputFile());
   simc->add_flag("--trace", sim_trace, "also write trace.csv: every motion, dwell and tool change with its time and line");
   std::string schedule;
   simc->add_option("--schedule", schedule, "plan manifest (plan.json): start each program at its planned time, the machine "
-                   "off in between (the stepped workpiece's 3 h waits)")->check(CLI::ExistingFile);
+                   "off in between (the stepped workpiece's 3 h waits)")->check(cli::inputFile());
 
   std::vector<std::string> check_programs;
   bool check_json = false;
   auto* chk = app.add_subcommand("check", "Safety verifier: travel, collisions, probe protection, rotary moves and spindle "
                                           "checked from the program text (exit 0 safe, 3 findings, 2 bad input)");
   chk->add_option("programs", check_programs, "G-code programs (.ngc LinuxCNC, .nc Fanuc macro B), run back to back "
-                  "(material cut by one is gone for the next)")->required()->check(CLI::ExistingFile);
-  chk->add_option("--machine", machine, "machine description (YAML)")->required()->check(CLI::ExistingFile);
+                  "(material cut by one is gone for the next)")->required()->check(cli::inputFile());
+  chk->add_option("--machine", machine, "machine description (YAML)")->required()->check(cli::inputFile());
   chk->add_option("--part", part, "what stands on the table: a sphere artifact, a thermal test piece, a stepped workpiece "
-                  "or a workpiece (YAML)")->required()->check(CLI::ExistingFile);
+                  "or a workpiece (YAML)")->required()->check(cli::inputFile());
   chk->add_flag("--json", check_json, "the report as JSON");
 
   std::string compare_with;
   auto* ev = app.add_subcommand("evaluate", "Errors of a test piece from probe logs, points CSV, a CMM export or dial-gauge readings");
-  ev->add_option("points", points, "LinuxCNC log, Fanuc DPRNT output, points CSV, CMM export (CSV, QIF 3.0 Results or DMIS output) or gauge CSV")->required()->check(CLI::ExistingFile);
-  ev->add_option("--manifest", manifest, "plan manifest (plan.json)")->required()->check(CLI::ExistingFile);
+  ev->add_option("points", points, "LinuxCNC log, Fanuc DPRNT output, points CSV, CMM export (CSV, QIF 3.0 Results or DMIS output) or gauge CSV")->required()->check(cli::inputFile());
+  ev->add_option("--manifest", manifest, "plan manifest (plan.json)")->required()->check(cli::inputFile());
   ev->add_option("--out", out, "output folder")->capture_default_str();
   ev->add_option("--format", format, "auto, linuxcnc, fanuc, csv, cmm, qif, dmis or gauge")
       ->check(CLI::IsMember({"auto", "linuxcnc", "fanuc", "csv", "cmm", "qif", "dmis", "gauge"}))->capture_default_str();
@@ -468,18 +469,18 @@ int main(int argc, char** argv) {
       ->capture_default_str()->check(CLI::PositiveNumber);
   std::string probe_log;
   ev->add_option("--probe-log", probe_log, "stepped workpiece: the on-machine probe log, evaluated with the CMM export (seed 000: CMM - probe)")
-      ->check(CLI::ExistingFile);
+      ->check(cli::inputFile());
   std::string cycle_starts;
   ev->add_option("--cycle-starts", cycle_starts, "sphere campaign: a CSV cycle,start_s of when each cycle started (s, the inputs' "
-                 "clock), for a log without clocks; replaces the plan's schedule")->check(CLI::ExistingFile);
+                 "clock), for a log without clocks; replaces the plan's schedule")->check(cli::inputFile());
   ev->add_option("--compare", compare_with, "another run's evaluation.json: thermal test piece, seed 004 Table 7.2 reductions; stepped workpiece, the part before its compensation (before/after)")
-      ->check(CLI::ExistingFile);
+      ->check(cli::inputFile());
 
   FitArgs fa;
   auto* fit = app.add_subcommand("fit", "Fit one geometric element to a point cloud (CSV, NIST .ds, XYZ, PLY)");
   fit->add_option("kind", fa.kind, "line2d, line3d, plane, circle2d, circle3d, sphere, cylinder or cone")
       ->required()->check(CLI::IsMember({"line2d", "line3d", "plane", "circle2d", "circle3d", "sphere", "cylinder", "cone"}));
-  fit->add_option("points", fa.points, "points file")->required()->check(CLI::ExistingFile);
+  fit->add_option("points", fa.points, "points file")->required()->check(cli::inputFile());
   fit->add_option("--method", fa.method, "ls (least squares), mz (minimum zone), mi (maximum inscribed), mc (minimum circumscribed)")
       ->check(CLI::IsMember({"ls", "mz", "mi", "mc"}))->capture_default_str();
   fit->add_option("--format", fa.format, "auto, csv, ds, xyz or ply")
@@ -502,7 +503,7 @@ int main(int argc, char** argv) {
   long gum_trials = 0;
   int gum_digits = 2;
   auto* gum = app.add_subcommand("gum", "Uncertainty of a user measurement model (YAML): GUM budget, Monte Carlo, validation");
-  gum->add_option("model", gum_model, "measurement model (YAML, kind: gum_model)")->required()->check(CLI::ExistingFile);
+  gum->add_option("model", gum_model, "measurement model (YAML, kind: gum_model)")->required()->check(cli::inputFile());
   gum->add_flag("--mcm", gum_mcm, "also run the Monte Carlo method (JCGM 101) and validate the GUF against it");
   gum->add_option("--trials", gum_trials, "Monte Carlo trials (0: adaptive, JCGM 101 7.9)")->capture_default_str()->check(CLI::NonNegativeNumber);
   gum->add_option("--digits", gum_digits, "adaptive stop: significant digits of u (n_dig)")->capture_default_str()->check(CLI::Range(1, 4));
@@ -516,8 +517,15 @@ int main(int argc, char** argv) {
   CLI::App* separate_cmd = nullptr;
   const auto run_separate = cli::addSeparateCommand(app, separate_cmd);
 
-  CLI11_PARSE(app, argc, argv);
   try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // CLI11's own codes (105 for a file option, 106 for a number...) are not ours: every usage
+    // error, an input path that is not a readable regular file included, exits 2 (cli/README.md).
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+  const auto dispatch = [&]() -> int {
     if (*model_group) return run_model();
     if (*report_group) return run_report();
     if (*separate_cmd) return run_separate();
@@ -531,9 +539,17 @@ int main(int argc, char** argv) {
     if (*gum) return cmdGum(gum_model, gum_mcm || gum_trials > 0, gum_trials, seed, gum_digits, gum_json);
     if (*ev)
       return cmdEvaluate(points, manifest, out, format, free_radius, scene, exaggeration, compare_with, gauge_resolution_um, probe_log, cycle_starts);
+    return 2;
+  };
+  try {
+    // All of a command's outputs or none (docs/reliability.md#all-or-nothing): the files are
+    // written as temporaries and renamed into place only after the command succeeded.
+    OutputBatch outputs;
+    const int code = dispatch();
+    if (code == 0) outputs.commit();
+    return code;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "probeloop: error: %s\n", e.what());
     return 1;
   }
-  return 2;
 }

@@ -8,6 +8,7 @@
 #include <optional>
 #include <sstream>
 
+#include "cli/input_option.hpp"
 #include "core/atomic_file.hpp"
 #include "core/csv.hpp"
 #include "core/error.hpp"
@@ -224,37 +225,37 @@ std::function<int()> addModelCommands(CLI::App& app, CLI::App*& group) {
   group = app.add_subcommand("model", "Error models against measurements: fit, compare, diagnose, add an effect");
   group->require_subcommand(1);
   auto data = [a](CLI::App* s) {
-    s->add_option("--inputs", a->inputs, "inputs.csv of the campaign (default: data.inputs of the model file)")->check(CLI::ExistingFile);
-    s->add_option("--errors", a->errors, "errors.csv of the campaign (default: data.errors of the model file)")->check(CLI::ExistingFile);
+    s->add_option("--inputs", a->inputs, "inputs.csv of the campaign (default: data.inputs of the model file)")->check(cli::inputFile());
+    s->add_option("--errors", a->errors, "errors.csv of the campaign (default: data.errors of the model file)")->check(cli::inputFile());
     s->add_option("--json", a->json, "also write the results as JSON to this file");
   };
   auto* fit = group->add_subcommand("fit", "Fit the model on the training span, predict the validation span, report the indicators");
-  fit->add_option("model", a->models, "error model (YAML, kind: error_model)")->required()->expected(1)->check(CLI::ExistingFile);
+  fit->add_option("model", a->models, "error model (YAML, kind: error_model)")->required()->expected(1)->check(cli::inputFile());
   data(fit);
   fit->add_option("--report", a->report, "also write the HTML report to this file");
   auto* cmp = group->add_subcommand("compare", "Several models on the same campaign, side by side");
-  cmp->add_option("models", a->models, "error models (YAML)")->required()->expected(1, 20)->check(CLI::ExistingFile);
+  cmp->add_option("models", a->models, "error models (YAML)")->required()->expected(1, 20)->check(cli::inputFile());
   data(cmp);
   auto* dia = group->add_subcommand("diagnose", "Where the model fails and which effect is missing, ranked, with the command that adds it");
-  dia->add_option("model", a->models, "error model (YAML)")->required()->expected(1)->check(CLI::ExistingFile);
+  dia->add_option("model", a->models, "error model (YAML)")->required()->expected(1)->check(cli::inputFile());
   data(dia);
-  dia->add_option("--part", a->part, "the test piece (YAML: sphere artifact, thermal test piece): enables its expansion candidates")->check(CLI::ExistingFile);
+  dia->add_option("--part", a->part, "the test piece (YAML: sphere artifact, thermal test piece): enables its expansion candidates")->check(cli::inputFile());
   dia->add_option("--report", a->report, "also write the HTML report to this file");
   auto* add = group->add_subcommand("add", "Add an effect to channels of a model file (marked just_added: the next fit shows before and after)");
   add->add_option("effect", a->kind, "drift, static, lag, transient or expansion")
       ->required()->check(CLI::IsMember({"drift", "static", "lag", "transient", "expansion"}));
-  add->add_option("--model", a->model, "error model file to edit")->required()->check(CLI::ExistingFile);
+  add->add_option("--model", a->model, "error model file to edit")->required()->check(cli::inputFile());
   add->add_option("--channels", a->channels, "comma-separated channels, e.g. EY0C_um,EZ0T_um")->required();
   add->add_option("--input", a->input, "inputs.csv column the effect reads");
   add->add_option("--lever", a->lever, "static/lag: an inputs column the effect acts over (lag spindle_rpm --lever travel_mm: a thermal scale error)");
   add->add_option("--tau-s", a->tau_s, "lag/transient: time constant to start from, s")->check(CLI::PositiveNumber);
   add->add_flag("--tau-fixed", a->tau_fixed, "keep the time constant fixed");
-  add->add_option("--part", a->part, "expansion: the test piece (YAML) giving alpha and the levers")->check(CLI::ExistingFile);
+  add->add_option("--part", a->part, "expansion: the test piece (YAML) giving alpha and the levers")->check(cli::inputFile());
   add->add_option("--alpha-um-per-m-K", a->alpha, "expansion: coefficient")->check(CLI::PositiveNumber);
   add->add_option("--length-mm", a->length_mm, "expansion: signed lever L of alpha L dT, mm");
   auto* talc = group->add_subcommand("talc", "Adaptive replay of seed 004 Ch. 6 (TALC) over a densely measured campaign: P99 reduction as Tables 6.5/6.7");
-  talc->add_option("--inputs", a->inputs, "inputs.csv of the campaign")->required()->check(CLI::ExistingFile);
-  talc->add_option("--errors", a->errors, "errors.csv of the campaign (measured densely)")->required()->check(CLI::ExistingFile);
+  talc->add_option("--inputs", a->inputs, "inputs.csv of the campaign")->required()->check(cli::inputFile());
+  talc->add_option("--errors", a->errors, "errors.csv of the campaign (measured densely)")->required()->check(cli::inputFile());
   talc->add_option("--cp-h", a->talc.cp_h, "calibration phase, h (0: as short as possible)")->capture_default_str()->check(CLI::NonNegativeNumber);
   talc->add_option("--post-interval-h", a->talc.post_interval_h, "measurement interval after the CP, h")->capture_default_str()->check(CLI::PositiveNumber);
   talc->add_option("--ng-interval-min", a->talc.ng_interval_min, "No-Good phase measurement interval, min")->capture_default_str()->check(CLI::PositiveNumber);
@@ -271,12 +272,12 @@ std::function<int()> addModelCommands(CLI::App& app, CLI::App*& group) {
   auto* series = group->add_subcommand("series", "Stepped workpiece: several parts' evaluations and logged inputs -> one campaign "
                                        "(inputs.csv, errors.csv, a position-only model.yaml) for fit, diagnose and add");
   series->add_option("--part", a->series_parts, "a part's evaluation.json and its machine's inputs.csv (repeat, in cut order)")
-      ->required()->type_size(2)->allow_extra_args(false)->check(CLI::ExistingFile);
+      ->required()->type_size(2)->allow_extra_args(false)->check(cli::inputFile());
   series->add_option("--gap-h", a->gap_h, "hours the machine stands between two parts")->capture_default_str()->check(CLI::NonNegativeNumber);
   series->add_option("--train-parts", a->train_parts, "the first N parts train, the rest validate (default: the first 60 % of the steps)")
       ->check(CLI::PositiveNumber);
   series->add_option("--start-from", a->start_from, "model.yaml whose effects the new model starts from (default: the position error only)")
-      ->check(CLI::ExistingFile);
+      ->check(cli::inputFile());
   series->add_option("--out", a->out, "output folder")->capture_default_str();
   return [a, fit, cmp, dia, add, talc, series]() -> int {
     if (*series) return runSeries(*a);

@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "cli/input_option.hpp"
 #include "cli/json_file.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
@@ -92,14 +93,14 @@ std::function<int()> addReportCommands(CLI::App& app, CLI::App*& group) {
              "spans, budgets (HTML); the piece with its deviations (glTF)");
   ttp->add_option("--evaluation", a->evaluation, "evaluation.json of `probeloop evaluate` (thermal test piece)")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(cli::inputFile());
   ttp->add_option("--second", a->second, "the other route's evaluation.json of the same piece (CMM vs on-machine)")
-      ->check(CLI::ExistingFile);
+      ->check(cli::inputFile());
   ttp->add_option("--r-test", a->r_test, "errors.csv of an R-test (sphere cycle) on the same clock")
-      ->check(CLI::ExistingFile);
+      ->check(cli::inputFile());
   ttp->add_option("--html", a->html, "write the HTML report to this file");
   auto* manifest = ttp->add_option("--manifest", a->manifest, "plan.json of the test piece (for --scene)")
-                       ->check(CLI::ExistingFile);
+                       ->check(cli::inputFile());
   ttp->add_option("--scene", a->scene, "write a glTF scene of the piece with its deviations to this file")
       ->needs(manifest);
   ttp->add_option("--exaggeration", a->exaggeration,
@@ -119,7 +120,7 @@ std::function<int()> addReportCommands(CLI::App& app, CLI::App*& group) {
                  "a compensated part's before/after per feature (HTML)");
   sw->add_option("--evaluation", s->evaluation, "evaluation.json of `probeloop evaluate … --probe-log` (with --compare: before/after)")
       ->required()
-      ->check(CLI::ExistingFile);
+      ->check(cli::inputFile());
   sw->add_option("--html", s->html, "write the HTML report to this file")->required();
   return [a, ttp, s, sw]() -> int {
     if (*ttp) return runTtp(*a);

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "cli/input_option.hpp"
 #include "cli/json_file.hpp"
 #include "core/atomic_file.hpp"
 #include "model/control_errors.hpp"
@@ -61,16 +62,16 @@ std::function<int()> addSeparateCommand(CLI::App& app, CLI::App*& sub) {
                            "Stepped workpiece campaign: thermal stages (parts cut at one feed and speed: W1, W4, W6, W7) and the "
                            "process error of a part cut at changing feeds (W8) with the thermal error taken out");
   sub->add_option("--stage", a->stages, "evaluation.json of a thermal-stage part (repeat; parts at one speed are pooled)")
-      ->required()->check(CLI::ExistingFile);
-  sub->add_option("--process", a->process, "evaluation.json of the part cut at changing feeds (W8)")->check(CLI::ExistingFile);
+      ->required()->check(cli::inputFile());
+  sub->add_option("--process", a->process, "evaluation.json of the part cut at changing feeds (W8)")->check(cli::inputFile());
   sub->add_option("--control", a->control,
                   "evaluation.json of a part whose walls are joined by fast transitions (W2): its control error e_ctrl "
                   "against the process part (Eq. 3.11-3.14)")
-      ->check(CLI::ExistingFile);
+      ->check(cli::inputFile());
   sub->add_option("--force", a->force,
                   "evaluation.json of a part cut as one continuous path (W5): its control error under the process force "
                   "e_cpr against the process part (Eq. 3.15)")
-      ->check(CLI::ExistingFile);
+      ->check(cli::inputFile());
   sub->get_option("--control")->needs(sub->get_option("--process"));
   sub->get_option("--force")->needs(sub->get_option("--process"));
   sub->add_option("--out", a->out, "output folder")->capture_default_str();

@@ -12,42 +12,80 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
+#include <vector>
 
 #include "core/error.hpp"
 
 namespace probeloop {
 namespace {
 
-// The temporary file being written, for the signal handler: a fixed buffer (no allocation
-// in the handler) and a flag set only while the buffer holds a complete path.
-char g_temporary[4096];
-volatile std::sig_atomic_t g_writing = 0;
+// The temporary files the signal handler removes: the one being written, and with a batch open
+// every pending one. Fixed buffers (no allocation in the handler); a slot counts only once its
+// path is complete.
+constexpr std::size_t kSlots = 1024, kPathMax = 4096, kArena = 1 << 20;
+char g_arena[kArena];
+std::size_t g_start[kSlots];
+volatile std::sig_atomic_t g_slots = 0;
+std::size_t g_used = 0;
 
 extern "C" void onInterrupt(int signal) {
-  if (g_writing) ::unlink(g_temporary);  // async-signal-safe
+  const int n = g_slots;
+  for (int i = 0; i < n; ++i) ::unlink(g_arena + g_start[i]);  // async-signal-safe
   std::signal(signal, SIG_DFL);
   std::raise(signal);
 }
 
-// Marks `tmp` as the file to remove on an interrupt for the lifetime of the guard.
-class TemporaryGuard {
- public:
-  explicit TemporaryGuard(const std::string& tmp) {
-    // One writer at a time (the CLI writes its files one after another, on one thread). A
-    // path too long for the buffer is not removed on an interrupt; it is still atomic.
-    if (tmp.size() < sizeof g_temporary) {
-      std::memcpy(g_temporary, tmp.c_str(), tmp.size() + 1);
-      std::atomic_signal_fence(std::memory_order_seq_cst);  // the path before the flag
-      g_writing = 1;
-    }
-  }
-  ~TemporaryGuard() {
-    g_writing = 0;
-    std::atomic_signal_fence(std::memory_order_seq_cst);
-  }
-  TemporaryGuard(const TemporaryGuard&) = delete;
-  TemporaryGuard& operator=(const TemporaryGuard&) = delete;
+// Adds `tmp` to the paths removed on an interrupt; false when the table is full (the file is
+// still atomic, only not cleaned up on SIGINT).
+bool registerTemporary(const std::string& tmp) {
+  if (g_slots >= static_cast<int>(kSlots) || tmp.size() >= kPathMax || g_used + tmp.size() + 1 > kArena) return false;
+  std::memcpy(g_arena + g_used, tmp.c_str(), tmp.size() + 1);
+  g_start[g_slots] = g_used;
+  g_used += tmp.size() + 1;
+  std::atomic_signal_fence(std::memory_order_seq_cst);  // the path before the count
+  g_slots = g_slots + 1;
+  return true;
+}
+void forgetTemporaries(int keep) {
+  g_slots = keep;
+  std::atomic_signal_fence(std::memory_order_seq_cst);
+  g_used = keep == 0 ? 0 : g_used;
+}
+
+struct Pending {
+  std::string path, tmp;
 };
+bool g_batch_open = false;
+std::vector<Pending> g_pending;
+
+std::string key(const std::string& path) {
+  std::error_code ec;
+  const auto abs = std::filesystem::absolute(path, ec);
+  return (ec ? std::filesystem::path(path) : abs).lexically_normal().string();
+}
+
+// Writes `content` to `tmp` (flushed), or throws naming `path`.
+void writeTemporary(const std::string& path, const std::string& tmp, const std::string& content) {
+  std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+  if (!out) throw InputError(path, 0, std::string("cannot write: ") + std::strerror(errno));
+  out.write(content.data(), static_cast<std::streamsize>(content.size()));
+  out.flush();
+  if (!out) {
+    out.close();
+    std::remove(tmp.c_str());
+    throw InputError(path, 0, "write failed (disk full?)");
+  }
+}
+
+void renameIntoPlace(const std::string& path, const std::string& tmp) {
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    throw InputError(path, 0, "cannot rename temporary file into place: " + ec.message());
+  }
+}
 
 }  // namespace
 
@@ -67,32 +105,67 @@ void writeFileAtomic(const std::string& path, const std::string& content) {
   namespace fs = std::filesystem;
   const fs::path target(path);
   if (target.has_parent_path()) fs::create_directories(target.parent_path());
+  if (g_batch_open) {
+    // The same output written twice in one command: the later content wins, one temporary.
+    const std::string k = key(path);
+    for (const auto& p : g_pending)
+      if (key(p.path) == k) {
+        writeTemporary(path, p.tmp, content);
+        return;
+      }
+    const std::string tmp = path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(g_pending.size());
+    registerTemporary(tmp);
+    g_pending.push_back({path, tmp});
+    writeTemporary(path, tmp, content);
+    return;
+  }
   const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-  const TemporaryGuard guard(tmp);
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError(path, 0, std::string("cannot write: ") + std::strerror(errno));
-    out.write(content.data(), static_cast<std::streamsize>(content.size()));
-    out.flush();
-    if (!out) {
-      std::remove(tmp.c_str());
-      throw InputError(path, 0, "write failed (disk full?)");
-    }
+  const int before = g_slots;
+  registerTemporary(tmp);
+  try {
+    writeTemporary(path, tmp, content);
+    renameIntoPlace(path, tmp);
+  } catch (...) {
+    forgetTemporaries(before);
+    throw;
   }
-  std::error_code ec;
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    std::remove(tmp.c_str());
-    throw InputError(path, 0, "cannot rename temporary file into place: " + ec.message());
-  }
+  forgetTemporaries(before);
 }
 
-std::string readFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, 0, std::string("cannot open: ") + std::strerror(errno));
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+OutputBatch::OutputBatch() {
+  if (g_batch_open) throw std::logic_error("OutputBatch: a batch is already open");
+  g_batch_open = true;
+  g_pending.clear();
+}
+
+OutputBatch::~OutputBatch() {
+  for (const auto& p : g_pending) std::remove(p.tmp.c_str());
+  forgetTemporaries(0);
+  g_pending.clear();
+  g_batch_open = false;
+}
+
+void OutputBatch::commit() {
+  std::vector<Pending> pending;
+  pending.swap(g_pending);
+  for (std::size_t i = 0; i < pending.size(); ++i) {
+    try {
+      renameIntoPlace(pending[i].path, pending[i].tmp);
+    } catch (...) {
+      for (std::size_t k = i + 1; k < pending.size(); ++k) std::remove(pending[k].tmp.c_str());
+      forgetTemporaries(0);
+      throw;
+    }
+  }
+  forgetTemporaries(0);
+}
+
+std::string pendingOutput(const std::string& path) {
+  if (!g_batch_open || g_pending.empty()) return "";
+  const std::string k = key(path);
+  for (const auto& p : g_pending)
+    if (key(p.path) == k) return p.tmp;
+  return "";
 }
 
 }  // namespace probeloop

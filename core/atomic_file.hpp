@@ -3,17 +3,41 @@
 // does a crash or a kill at any moment: rename(2) replaces the file in one step, so a reader
 // sees the old file or the new one, never a torn one. (No fsync: a power cut right after the
 // rename may still lose the new content; that is outside what this promises.)
+//
+// A command's outputs together (docs/reliability.md#all-or-nothing): while an OutputBatch is
+// open, writeFileAtomic only writes the temporary files; commit() renames them all into
+// place, in the order they were written, after the command has succeeded. A batch closed
+// without commit() (an exception, an early return) removes its temporaries: every output
+// keeps its old version. Within the batch, readFile() of a path written earlier reads the
+// pending content (a command may read back what it wrote).
 #pragma once
 #include <string>
+
+#include "core/input_file.hpp"
 
 namespace probeloop {
 
 void writeFileAtomic(const std::string& path, const std::string& content);
 
-// SIGINT / SIGTERM while a file is being written remove its temporary file before the
-// process ends with the signal's usual status (128 + signal). Called once by main(). A
-// SIGKILL cannot be caught: it may leave one "<path>.tmp-<pid>" beside the old file.
+// SIGINT / SIGTERM while a file is being written remove its temporary file (with a batch open,
+// every pending one) before the process ends with the signal's usual status (128 + signal).
+// Called once by main(). A SIGKILL cannot be caught: it may leave "<path>.tmp-<pid>" files
+// beside the old ones (never in their place).
 void removeTemporaryFileOnInterrupt();
-std::string readFile(const std::string& path);  // InputError if unreadable
+
+class OutputBatch {
+ public:
+  OutputBatch();   // one at a time; a second open batch is a logic_error
+  ~OutputBatch();  // without commit(): the temporaries are removed
+  // Renames every pending file into place. A rename that fails (the disk, permissions) stops
+  // there with an InputError naming the file; the files renamed before it are in place (each
+  // one whole), the rest keep their old versions and their temporaries are removed.
+  void commit();
+  OutputBatch(const OutputBatch&) = delete;
+  OutputBatch& operator=(const OutputBatch&) = delete;
+};
+
+// The temporary file holding `path`'s pending content in the open batch; empty if none.
+std::string pendingOutput(const std::string& path);
 
 }  // namespace probeloop

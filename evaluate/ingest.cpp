@@ -167,8 +167,14 @@ std::vector<ProbeRecord> fromCsv(const std::string& text, const std::string& fil
 std::vector<ProbeRecord> readProbeRecords(const std::string& path, PointsFormat format,
                                           const parts::PlanManifest& m) {
   const std::string text = readFile(path);
-  if (format == PointsFormat::Auto)
+  if (format == PointsFormat::Auto) {
     format = looksLikeCsv(text) ? PointsFormat::PointsCsv : PointsFormat::LinuxCncLog;
+    // A file of another kind is named as what it is, not misread line by line.
+    const std::string kind = describeContent(text);
+    if (format == PointsFormat::LinuxCncLog && !kind.empty() && kind.find("probe log") == std::string::npos)
+      throw InputError(path, 0, "this is " + kind + "; a sphere-artifact campaign is evaluated from the probe log the "
+                                "cycle writes (LinuxCNC LOG or Fanuc DPRNT: PT lines) or a points CSV");
+  }
   std::vector<ProbeRecord> out;
   if (format == PointsFormat::PointsCsv) {
     out = fromCsv(text, path, m);
@@ -185,6 +191,8 @@ std::vector<ProbeRecord> readProbeRecords(const std::string& path, PointsFormat 
       out.push_back(r);
     }
   }
+  if (out.empty())
+    throw InputError(path, 0, "no probe points in the file: nothing to evaluate (expected the cycle's PT lines or points CSV rows)");
   // Every record must belong to the plan.
   const int per = m.pointsPerSphere();
   std::set<std::tuple<int, int, int>> keys;

@@ -355,7 +355,8 @@ PointCloud readPointCloud(const std::string& path, const std::string& format_in,
   pc.format = format_in == "auto" || format_in.empty() ? extensionFormat(path) : format_in;
   if (!feature.empty() && pc.format != "csv")
     throw InputError(path, 0, "--feature selects rows of a points CSV; this file is " + pc.format);
-  const std::string text = readFile(path);
+  // Binary PLY holds NUL bytes; every other format is text (NUL refused, UTF-16 transcoded).
+  const std::string text = readFile(path, pc.format == "ply" ? kPointCloudInput : kAnyInput);
   if (pc.format == "csv") readCsv(pc, text, feature);
   else if (pc.format == "ds") readDs(pc, text);
   else if (pc.format == "xyz") readXyz(pc, text);

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/csv.hpp"
+#include "core/input_file.hpp"
 #include "core/error.hpp"
 #include "interop/dmis.hpp"
 #include "interop/qif.hpp"
@@ -129,7 +130,13 @@ std::string detectTtpFormat(const std::string& path, const std::string& text) {
   if (interop::looksLikeDmis(text)) return "dmis";
   const std::string first = firstDataLine(text);
   const bool csv = first.find(',') != std::string::npos || first.find(';') != std::string::npos || csvExtension(path);
-  if (!csv) return "log";  // a PT log: LinuxCNC LOG and Fanuc DPRNT lines parse alike
+  if (!csv) {  // a PT log: LinuxCNC LOG and Fanuc DPRNT lines parse alike
+    const std::string kind = describeContent(text);
+    if (!kind.empty() && kind.find("probe log") == std::string::npos)
+      throw InputError(path, 0, "this is " + kind + "; a test piece is evaluated from a CMM export (CSV, QIF 3.0 Results, "
+                                "DMIS output), the on-machine probe log (PT lines), a points CSV or dial-gauge readings");
+    return "log";
+  }
   const auto h = csvHeaderFields(text);
   if (has(h, "g_um")) return "gauge";
   if (has(h, "c_deg") || has(h, "time_s")) return "csv";

@@ -1,8 +1,15 @@
 // A machine for the interpreter harnesses: it accepts every move, answers probe moves
 // alternately with a contact halfway along the move and with no contact, knows tools 1..99,
 // and keeps a clock. No physics: the harness fuzzes the interpreter, not the simulator.
+//
+// The property it checks (issue 28): the interpreter hands the machine only finite
+// coordinates. A program that computes an infinity or a NaN must be refused (InputError) before
+// a move to it; a non-finite coordinate reaching the machine aborts, which the fuzzer reports
+// as a finding. The safety verifier relies on it: a NaN compares false with every limit.
 #pragma once
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include "core/error.hpp"
@@ -10,7 +17,7 @@
 
 namespace probeloop::fuzz {
 
-// The interpreter's own bound is 1e8 blocks (a program that never ends); a fuzz input gets
+// The interpreter's own bound is 2e7 blocks (a program that never ends); a fuzz input gets
 // far fewer so that a loop costs milliseconds, not a timeout.
 constexpr long kMaxBlocks = 20'000;
 
@@ -20,6 +27,7 @@ class FuzzMachine : public gcode::MachineInterface {
   void feed(const gcode::MachinePosition& to, double feed_mm_per_min) override { move(to, feed_mm_per_min); }
   gcode::ProbeOutcome probe(const gcode::MachinePosition& to, double feed_mm_per_min,
                             gcode::ProbeMode /*mode*/) override {
+    requireFinite(to);
     gcode::ProbeOutcome out;
     out.contact = (probes_++ % 2) == 0;
     out.stop = to;
@@ -45,7 +53,13 @@ class FuzzMachine : public gcode::MachineInterface {
   double controllerClockS() const override { return clock_s_; }
 
  private:
+  static void requireFinite(const gcode::MachinePosition& to) {
+    if (to.xyz_mm.allFinite() && std::isfinite(to.b_deg) && std::isfinite(to.c_deg)) return;
+    std::fprintf(stderr, "fuzz machine: the interpreter handed a non-finite coordinate to the machine\n");
+    std::abort();
+  }
   void move(const gcode::MachinePosition& to, double feed_mm_per_min) {
+    requireFinite(to);
     const double d = (to.xyz_mm - at_.xyz_mm).norm();
     if (std::isfinite(d) && feed_mm_per_min > 0) clock_s_ += 60.0 * d / feed_mm_per_min;
     at_ = to;

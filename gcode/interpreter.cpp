@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <memory>
 #include <optional>
 #include <set>
 #include <string_view>
@@ -113,16 +114,30 @@ double Interpreter::namedParameter(const std::string& name) const {
 // One run of the program: cursor, modal state and control flow.
 class Execution {
  public:
-  Execution(Interpreter& in, MachineInterface& m) : in_(in), m_(m), pos_(m.start()) {}
+  Execution(Interpreter& in, MachineInterface& m, ProbeBranching* branching)
+      : in_(in), m_(m), params_(in.params_), named_(in.named_), branching_(branching), pos_(m.start()) {}
 
   InterpreterResult run(long max_blocks) {
     buildJumps();
+    max_blocks_ = max_blocks;
+    return runFrom(0);
+  }
+
+  // The parameters as the run left them (for Interpreter::parameter).
+  void publishParameters() const {
+    in_.params_ = params_;
+    in_.named_ = named_;
+  }
+
+ private:
+  InterpreterResult runFrom(std::size_t start) {
     InterpreterResult r;
-    pc_ = 0;
+    pc_ = start;
     while (pc_ < in_.lines_.size()) {
-      if (++r.blocks_executed > max_blocks)
-        fail("the program executed " + std::to_string(max_blocks) +
+      if (++blocks_ > max_blocks_)
+        fail("the program executed " + std::to_string(max_blocks_) +
              " blocks without ending; an endless loop?");
+      r.blocks_executed = blocks_;
       const auto& line = in_.lines_[pc_];
       line_ = line.number;
       m_.atLine(line_);
@@ -142,12 +157,23 @@ class Execution {
       }
       pc_ = next;
     }
+    r.blocks_executed = blocks_;
     return r;
   }
 
- private:
   Interpreter& in_;
   MachineInterface& m_;
+  // Parameters of this run (a probe branch has its own copy): numbered and named.
+  std::map<int, double> params_;
+  std::map<std::string, double> named_;
+  double parameter(int n) const {
+    const auto it = params_.find(n);
+    return it == params_.end() ? 0.0 : it->second;
+  }
+  ProbeBranching* branching_ = nullptr;
+  long max_blocks_ = Interpreter::kMaxBlocks;
+  long blocks_ = 0;       // blocks executed so far (a branch goes on counting)
+  bool line_ends_ = false;  // M2/M30 on the line being executed
   std::size_t pc_ = 0;
   int line_ = 0;
 
@@ -166,11 +192,17 @@ class Execution {
   bool seen_program_number_ = false;
 
   // Control flow.
-  std::map<std::size_t, std::size_t> jump_;       // line index -> matching end / next branch
-  std::map<std::size_t, std::size_t> loop_back_;  // end of loop -> its head
-  std::map<int, std::size_t> labels_;             // Fanuc N labels
+  // Resolved once per run, before it starts; a probe branch shares them.
+  struct Control {
+    std::map<std::size_t, std::size_t> jump;       // line index -> matching end / next branch
+    std::map<std::size_t, std::size_t> loop_back;  // end of loop -> its head
+    std::map<int, std::size_t> labels;             // Fanuc N labels
+    std::map<std::size_t, std::size_t> endif_of;   // elseif/else line -> its endif
+  };
+  std::shared_ptr<Control> control_;
 
   [[noreturn]] void fail(const std::string& m) const { throw InputError(in_.file_, line_, m); }
+
 
   // ---------------------------------------------------------------------------------
   // Expressions
@@ -212,6 +244,16 @@ class Execution {
     }
   };
 
+  // Every value the program computes must be a finite number: an overflow (EXP[1000],
+  // [1e300*1e300]) or what follows from one (inf - inf = NaN) stops the program here, as a
+  // controller stops with a calculation-overflow alarm. A NaN let through would compare false
+  // with every limit and a move to it could pass any check (issue 28).
+  double finite(double v, const Cursor& c, const char* what) const {
+    if (std::isfinite(v)) return v;
+    fail(std::string(what) + " in '" + c.s + "' gives " + (std::isnan(v) ? "NaN" : "an infinite value") +
+         ": not a finite number (overflow); the controller stops here");
+  }
+
   double number(Cursor& c) {
     const std::size_t b = c.i;
     while (!c.end() && (std::isdigit(static_cast<unsigned char>(c.peek())) || c.peek() == '.')) ++c.i;
@@ -240,8 +282,8 @@ class Execution {
       if (close == std::string::npos) fail("named parameter '#<' is not closed");
       const std::string name = c.s.substr(c.i + 1, close - c.i - 1);
       c.i = close + 1;
-      const auto it = in_.named_.find(name);
-      if (it == in_.named_.end()) fail("named parameter #<" + name + "> is read before it is set");
+      const auto it = named_.find(name);
+      if (it == named_.end()) fail("named parameter #<" + name + "> is read before it is set");
       return it->second;
     }
     return paramValue(paramNumber(c));
@@ -250,7 +292,7 @@ class Execution {
   // A numbered parameter; Fanuc's #3011 (date YYYYMMDD) and #3012 (time HHMMSS) read the
   // controller's clock.
   double paramValue(int n) {
-    if (in_.dialect_ != ProgramDialect::FanucMacroB || (n != 3011 && n != 3012)) return in_.parameter(n);
+    if (in_.dialect_ != ProgramDialect::FanucMacroB || (n != 3011 && n != 3012)) return parameter(n);
     const double s = std::max(0.0, m_.controllerClockS());
     const long days = static_cast<long>(std::floor(s / 86400.0));
     const long sec = static_cast<long>(std::floor(s - 86400.0 * static_cast<double>(days)));
@@ -290,42 +332,44 @@ class Execution {
     static const char* functions[] = {"ABS", "ACOS", "ASIN", "ATAN", "COS", "EXP", "FIX", "FUP",
                                       "LN", "ROUND", "SIN", "SQRT", "TAN"};
     for (const char* f : functions) {
-      if (c.take(f)) {
-        const std::string fn = f;
-        const double a = bracket(c);
-        if (fn == "ATAN") {
-          if (c.take("/")) {
-            const double deg = std::atan2(a, bracket(c)) * 180.0 / kPi;
-            // Fanuc answers in 0..360, LinuxCNC in -180..180.
-            return in_.dialect_ == ProgramDialect::FanucMacroB && deg < 0 ? deg + 360.0 : deg;
-          }
-          if (in_.dialect_ == ProgramDialect::LinuxCnc) fail("ATAN needs the form ATAN[y]/[x]");
-          return std::atan(a) * 180.0 / kPi;
-        }
-        if (fn == "ABS") return std::fabs(a);
-        if (fn == "ACOS" || fn == "ASIN") {
-          if (a < -1 || a > 1) fail(fn + " of " + std::to_string(a) + " is undefined");
-          return (fn == "ACOS" ? std::acos(a) : std::asin(a)) * 180.0 / kPi;
-        }
-        if (fn == "COS") return std::cos(a * kPi / 180.0);
-        if (fn == "SIN") return std::sin(a * kPi / 180.0);
-        if (fn == "TAN") return std::tan(a * kPi / 180.0);
-        if (fn == "EXP") return std::exp(a);
-        // LinuxCNC rounds down / up; Fanuc truncates toward / away from zero.
-        const bool fanuc = in_.dialect_ == ProgramDialect::FanucMacroB;
-        if (fn == "FIX") return fanuc ? std::trunc(a) : std::floor(a);
-        if (fn == "FUP") return fanuc ? (a < 0 ? std::floor(a) : std::ceil(a)) : std::ceil(a);
-        if (fn == "ROUND") return std::round(a);
-        if (fn == "LN") {
-          if (a <= 0) fail("LN of a non-positive value");
-          return std::log(a);
-        }
-        if (a < 0) fail("SQRT of a negative value");
-        return std::sqrt(a);
-      }
+      if (c.take(f)) return finite(function(f, c), c, f);
     }
     fail("unexpected '" + std::string(1, c.peek()) + "' at column " + std::to_string(c.i + 1) +
          " of '" + c.s + "' (expected a number, #parameter, [expression] or function)");
+  }
+
+  // A function's value, after its name.
+  double function(const std::string& fn, Cursor& c) {
+    const double a = bracket(c);
+    if (fn == "ATAN") {
+      if (c.take("/")) {
+        const double deg = std::atan2(a, bracket(c)) * 180.0 / kPi;
+        // Fanuc answers in 0..360, LinuxCNC in -180..180.
+        return in_.dialect_ == ProgramDialect::FanucMacroB && deg < 0 ? deg + 360.0 : deg;
+      }
+      if (in_.dialect_ == ProgramDialect::LinuxCnc) fail("ATAN needs the form ATAN[y]/[x]");
+      return std::atan(a) * 180.0 / kPi;
+    }
+    if (fn == "ABS") return std::fabs(a);
+    if (fn == "ACOS" || fn == "ASIN") {
+      if (a < -1 || a > 1) fail(fn + " of " + std::to_string(a) + " is undefined");
+      return (fn == "ACOS" ? std::acos(a) : std::asin(a)) * 180.0 / kPi;
+    }
+    if (fn == "COS") return std::cos(a * kPi / 180.0);
+    if (fn == "SIN") return std::sin(a * kPi / 180.0);
+    if (fn == "TAN") return std::tan(a * kPi / 180.0);
+    if (fn == "EXP") return std::exp(a);
+    // LinuxCNC rounds down / up; Fanuc truncates toward / away from zero.
+    const bool fanuc = in_.dialect_ == ProgramDialect::FanucMacroB;
+    if (fn == "FIX") return fanuc ? std::trunc(a) : std::floor(a);
+    if (fn == "FUP") return fanuc ? (a < 0 ? std::floor(a) : std::ceil(a)) : std::ceil(a);
+    if (fn == "ROUND") return std::round(a);
+    if (fn == "LN") {
+      if (a <= 0) fail("LN of a non-positive value");
+      return std::log(a);
+    }
+    if (a < 0) fail("SQRT of a negative value");
+    return std::sqrt(a);
   }
 
   double power(Cursor& c) {
@@ -333,19 +377,18 @@ class Execution {
     while (c.take("**")) {
       const double e = primary(c);
       if (v < 0 && e != std::floor(e)) fail("a negative number to a non-integer power is undefined");
-      v = std::pow(v, e);
-      if (!std::isfinite(v)) fail("** overflows");
+      v = finite(std::pow(v, e), c, "a power (**)");
     }
     return v;
   }
   double product(Cursor& c) {
     double v = power(c);
     for (;;) {
-      if (c.s.compare(c.i, 2, "**") != 0 && c.take("*")) v *= power(c);
+      if (c.s.compare(c.i, 2, "**") != 0 && c.take("*")) v = finite(v * power(c), c, "a product");
       else if (c.take("/")) {
         const double d = power(c);
         if (d == 0) fail("division by zero");
-        v /= d;
+        v = finite(v / d, c, "a quotient");
       } else if (c.take("MOD")) {
         const double d = power(c);
         if (d == 0) fail("MOD by zero");
@@ -357,8 +400,8 @@ class Execution {
   double sum(Cursor& c) {
     double v = product(c);
     for (;;) {
-      if (c.take("+")) v += product(c);
-      else if (c.take("-")) v -= product(c);
+      if (c.take("+")) v = finite(v + product(c), c, "a sum");
+      else if (c.take("-")) v = finite(v - product(c), c, "a difference");
       else return v;
     }
   }
@@ -428,6 +471,7 @@ class Execution {
   }
 
   void buildJumps() {
+    control_ = std::make_shared<Control>();
     const auto& L = in_.lines_;
     std::vector<std::pair<std::string, std::size_t>> stack;  // keyword@label, line index
     std::map<std::size_t, std::vector<std::size_t>> branches;  // if -> elseif/else lines
@@ -456,18 +500,18 @@ class Execution {
           const std::size_t head = stack.back().second;
           stack.pop_back();
           if (o->keyword == "ENDWHILE") {
-            jump_[head] = k;
-            loop_back_[k] = head;
+            control_->jump[head] = k;
+            control_->loop_back[k] = head;
           } else {
             // Chain: if -> first branch -> next branch ... -> endif; each branch's end jumps
             // to endif (recorded as the branch line -> endif in loop_back_ with a marker).
             std::size_t prev = head;
             for (std::size_t b : branches[head]) {
-              jump_[prev] = b;
+              control_->jump[prev] = b;
               prev = b;
             }
-            jump_[prev] = k;
-            for (std::size_t b : branches[head]) endif_of_[b] = k;
+            control_->jump[prev] = k;
+            for (std::size_t b : branches[head]) control_->endif_of[b] = k;
           }
         } else {
           fail("o-word keyword '" + lower(o->keyword) + "' is not modelled by the simulator");
@@ -483,8 +527,8 @@ class Execution {
             const auto parsed = smallInt(code.substr(1, i - 1));
             if (!parsed) fail("label N" + code.substr(1, i - 1) + " is not a number of at most 6 digits");
             const int n = *parsed;
-            if (labels_.count(n)) fail("label N" + std::to_string(n) + " appears twice");
-            labels_[n] = k;
+            if (control_->labels.count(n)) fail("label N" + std::to_string(n) + " appears twice");
+            control_->labels[n] = k;
           }
         }
         const std::string rest = code.substr(i);
@@ -501,8 +545,8 @@ class Execution {
           const int m = *parsed;
           if (fanuc_do.empty() || fanuc_do.back().first != m)
             fail("END" + std::to_string(m) + " without a matching WHILE ... DO" + std::to_string(m));
-          jump_[fanuc_do.back().second] = k;
-          loop_back_[k] = fanuc_do.back().second;
+          control_->jump[fanuc_do.back().second] = k;
+          control_->loop_back[k] = fanuc_do.back().second;
           fanuc_do.pop_back();
         }
       }
@@ -516,7 +560,6 @@ class Execution {
       fail("WHILE ... DO" + std::to_string(fanuc_do.back().first) + " is never closed by END");
     }
   }
-  std::map<std::size_t, std::size_t> endif_of_;  // elseif/else line -> its endif
 
   // Returns true when the program ends.
   bool executeLine(const Interpreter::Line& line, std::size_t& next) {
@@ -548,14 +591,14 @@ class Execution {
     Cursor c{code, o.rest};
     const auto k = pc_;
     if (o.keyword == "WHILE") {
-      if (!condition(c)) next = jump_.at(k) + 1;
+      if (!condition(c)) next = control_->jump.at(k) + 1;
     } else if (o.keyword == "ENDIF") {
       // Reached by falling out of the last branch or by a jump: nothing to do.
     } else if (o.keyword == "ENDWHILE") {
-      next = loop_back_.at(k);
+      next = control_->loop_back.at(k);
     } else if (o.keyword == "IF") {
       if (!condition(c)) {
-        next = jump_.at(k);  // to the first elseif/else or the endif
+        next = control_->jump.at(k);  // to the first elseif/else or the endif
         branch_target_ = next;
       }
     } else if (o.keyword == "ELSEIF" || o.keyword == "ELSE") {
@@ -564,11 +607,11 @@ class Execution {
       if (branch_target_ == k) {
         branch_target_ = kNone;
         if (o.keyword == "ELSE" || condition(c)) return;
-        next = jump_.at(k);
+        next = control_->jump.at(k);
         branch_target_ = next;
         return;
       }
-      next = endif_of_.at(k);
+      next = control_->endif_of.at(k);
     }
   }
   static constexpr std::size_t kNone = static_cast<std::size_t>(-1);
@@ -587,11 +630,11 @@ class Execution {
     if (c.take("WHILE")) {
       const double v = bracket(c);
       if (!c.take("DO")) fail("WHILE [..] must be followed by DOm");
-      if (v == 0) next = jump_.at(pc_) + 1;
+      if (v == 0) next = control_->jump.at(pc_) + 1;
       return true;
     }
     if (c.take("END") && !c.end() && std::isdigit(static_cast<unsigned char>(c.peek()))) {
-      next = loop_back_.at(pc_);
+      next = control_->loop_back.at(pc_);
       return true;
     }
     c.i = 0;
@@ -640,8 +683,8 @@ class Execution {
   }
 
   std::size_t label(int n) {
-    const auto it = labels_.find(n);
-    if (it == labels_.end()) fail("GOTO " + std::to_string(n) + ": no block N" + std::to_string(n));
+    const auto it = control_->labels.find(n);
+    if (it == control_->labels.end()) fail("GOTO " + std::to_string(n) + ": no block N" + std::to_string(n));
     return it->second;
   }
 
@@ -703,8 +746,8 @@ class Execution {
             for (std::size_t k = i + 2; k < close; ++k)
               if (!std::isspace(static_cast<unsigned char>(text[k])))
                 name += static_cast<char>(std::tolower(static_cast<unsigned char>(text[k])));
-            const auto it = in_.named_.find(name);
-            if (it == in_.named_.end()) fail("LOG names #<" + name + ">, which is not set");
+            const auto it = named_.find(name);
+            if (it == named_.end()) fail("LOG names #<" + name + ">, which is not set");
             out += fmtLf(it->second);
             i = close + 1;
             continue;
@@ -714,7 +757,7 @@ class Execution {
           while (k < text.size() && std::isdigit(static_cast<unsigned char>(text[k]))) ++k;
           const auto n = smallInt(text.substr(i + 1, k - i - 1));
           if (!n) fail("LOG names #" + text.substr(i + 1, k - i - 1) + ", which is not a parameter number");
-          out += fmtLf(in_.parameter(*n));
+          out += fmtLf(parameter(*n));
           i = k;
           continue;
         }
@@ -749,7 +792,7 @@ class Execution {
     if (!c.end()) fail("unexpected '" + stmt.substr(c.i) + "' after a parameter assignment");
     for (const auto& [t, v] : sets) {
       if (std::holds_alternative<std::string>(t)) {
-        in_.named_[std::get<std::string>(t)] = v;
+        named_[std::get<std::string>(t)] = v;
         continue;
       }
       const int n = std::get<int>(t);
@@ -757,7 +800,7 @@ class Execution {
         stop(in_.file_, line_, "program alarm #3000=" + std::to_string(std::lround(v)) +
                                    alarmText(in_.lines_[pc_].comment));
       if (n >= 5000 && n < 6000) fail("parameter #" + std::to_string(n) + " is read-only");
-      in_.params_[n] = v;
+      params_[n] = v;
     }
   }
   static std::string alarmText(const std::string& comment) {
@@ -915,6 +958,7 @@ class Execution {
     if (motion) motion_ = *motion;
     bool axes = false;
     for (char a : ax) axes = axes || (w.has(a) && !w.used.count(a));
+    line_ends_ = end;
     if (axes) move(w, g53, g31);
     else if (g31 || g53) fail("G31/G53 without an axis word");
     finishWords(w);
@@ -933,8 +977,7 @@ class Execution {
     MachinePosition to = target(w, g53);
     if (g31) {
       requireFeed();
-      const auto r = m_.probe(to, feed_, ProbeMode::SkipToTarget);
-      setProbeResult(r);
+      probed(m_.probe(to, feed_, ProbeMode::SkipToTarget), ProbeMode::SkipToTarget);
       return;
     }
     if (isG(motion_, 0)) m_.rapid(to);
@@ -946,12 +989,8 @@ class Execution {
       arc(w, to, isG(motion_, 2));
     } else if (isG(motion_, 38.2) || isG(motion_, 38.3)) {
       requireFeed();
-      const auto r = m_.probe(to, feed_, isG(motion_, 38.2) ? ProbeMode::ErrorWithoutContact
-                                                            : ProbeMode::FlagContact);
-      if (isG(motion_, 38.2) && !r.contact)
-        stop(in_.file_, line_, "G38.2 probe move finished without contact");
-      in_.params_[5070] = r.contact ? 1 : 0;
-      setProbeResult(r);
+      const auto mode = isG(motion_, 38.2) ? ProbeMode::ErrorWithoutContact : ProbeMode::FlagContact;
+      probed(m_.probe(to, feed_, mode), mode);
       return;
     } else {
       fail("axis words with G80 active (no motion mode)");
@@ -961,6 +1000,33 @@ class Execution {
 
   void requireFeed() {
     if (!(feed_ > 0)) fail("a feed move without a feed rate F");
+  }
+
+  // A probe move's outcome. With a ProbeBranching, the rest of the program is first offered
+  // with another outcome, from a copy of this run's state (unless this outcome already stops
+  // the program: then there is nothing to protect).
+  void probed(const ProbeOutcome& r, ProbeMode mode) {
+    if (branching_ && !(mode == ProbeMode::ErrorWithoutContact && !r.contact)) {
+      branching_->atProbe(r, [this, mode](const ProbeOutcome& other) {
+        Execution branch = *this;
+        branch.branching_ = nullptr;  // a branch does not branch again
+        return branch.continueAfterProbe(other, mode);
+      });
+    }
+    applyProbe(r, mode);
+  }
+  void applyProbe(const ProbeOutcome& r, ProbeMode mode) {
+    if (mode == ProbeMode::ErrorWithoutContact && !r.contact)
+      stop(in_.file_, line_, "G38.2 probe move finished without contact");
+    if (mode != ProbeMode::SkipToTarget) params_[5070] = r.contact ? 1 : 0;
+    setProbeResult(r);
+  }
+  // A branch: this probe line finishes with `other`, then the program runs on from the next
+  // line (nothing on a probe line acts after its move but an M2/M30 on it).
+  InterpreterResult continueAfterProbe(const ProbeOutcome& other, ProbeMode mode) {
+    applyProbe(other, mode);
+    if (line_ends_) return InterpreterResult{blocks_, true};
+    return runFrom(pc_ + 1);
   }
 
   static std::string fmtG(double g) {
@@ -986,6 +1052,9 @@ class Execution {
       if (!w.has(ax[a])) continue;
       const double v = w.take(ax[a]);
       *dst[a] = absolute_ ? v + off[static_cast<std::size_t>(a)] : cur[a] + v;
+      if (!std::isfinite(*dst[a]))
+        fail(std::string("the ") + ax[a] + " target (" + formatG(v) + " plus the offset or the current position) is not a "
+             "finite number (overflow); the controller stops here");
     }
     return t;
   }
@@ -993,11 +1062,11 @@ class Execution {
   // After a probe move both dialects report the latched position in program coordinates.
   void setProbeResult(const ProbeOutcome& r) {
     const auto off = activeOffset();
-    in_.params_[5061] = r.stop.xyz_mm.x() - off[0];
-    in_.params_[5062] = r.stop.xyz_mm.y() - off[1];
-    in_.params_[5063] = r.stop.xyz_mm.z() - off[2];
-    in_.params_[5064] = r.stop.b_deg - off[3];
-    in_.params_[5065] = r.stop.c_deg - off[4];
+    params_[5061] = r.stop.xyz_mm.x() - off[0];
+    params_[5062] = r.stop.xyz_mm.y() - off[1];
+    params_[5063] = r.stop.xyz_mm.z() - off[2];
+    params_[5064] = r.stop.b_deg - off[3];
+    params_[5065] = r.stop.c_deg - off[4];
     pos_ = r.stop;
   }
 
@@ -1046,9 +1115,16 @@ class Execution {
   }
 };
 
-InterpreterResult Interpreter::run(MachineInterface& machine, long max_blocks) {
-  Execution e(*this, machine);
-  return e.run(max_blocks);
+InterpreterResult Interpreter::run(MachineInterface& machine, long max_blocks, ProbeBranching* branching) {
+  Execution e(*this, machine, branching);
+  try {
+    const auto r = e.run(max_blocks);
+    e.publishParameters();
+    return r;
+  } catch (...) {
+    e.publishParameters();
+    throw;
+  }
 }
 
 }  // namespace probeloop::gcode

@@ -16,6 +16,7 @@
 // raises (SafetyError, InputError without a line) are re-thrown with the program line.
 #pragma once
 #include <Eigen/Dense>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -69,13 +70,37 @@ struct InterpreterResult {
   bool ended = false;  // M2/M30 reached
 };
 
+// Each probe move's other outcome, tried without running the program again from its start
+// (the safety verifier: is every probe move protected?). Right after a probe move's outcome is
+// known, and only if that outcome does not itself stop the program (G38.2 without contact),
+// the interpreter calls atProbe with a function that runs the rest of the program from this
+// point with another outcome, on a copy of the run's state (position, modal state, parameters,
+// control flow): the nominal run then goes on as if nothing happened. The machine is the same
+// object in both, so atProbe saves and restores the machine's own state around the call.
+// Errors of the branch (a SafetyError where the program stops, an InputError) reach atProbe.
+// A branch does not branch again. The cost is that of the branch's own blocks: one run of the
+// program plus what each branch executes, not one run per probe line.
+class ProbeBranching {
+ public:
+  virtual ~ProbeBranching() = default;
+  using RunWith = std::function<InterpreterResult(const ProbeOutcome& other)>;
+  virtual void atProbe(const ProbeOutcome& nominal, const RunWith& run_with) = 0;
+};
+
 class Interpreter {
  public:
   Interpreter(ProgramDialect dialect, std::string file_name, const std::string& text);
 
-  // Runs from the first line to M2/M30 (or the end of the text). `max_blocks` bounds a
-  // program that never ends (an InputError names the line it was at).
-  InterpreterResult run(MachineInterface& machine, long max_blocks = 100'000'000);
+  // The bound on blocks executed in one run: a program that has not ended by then is taken for
+  // an endless loop (an InputError names the line it was at). The longest program we emit, a
+  // year of hourly sphere cycles (8760 cycles x 222 blocks), executes 1.94 million blocks; the
+  // bound is ten times that (a year of 6-minute cycles, or ten years of hourly ones). An
+  // endless loop with moves reaches it in seconds on a 2-core machine (docs/reliability.md:
+  // measured, for check and simulate), where 1e8 took about 27 s.
+  static constexpr long kMaxBlocks = 20'000'000;
+
+  // Runs from the first line to M2/M30 (or the end of the text).
+  InterpreterResult run(MachineInterface& machine, long max_blocks = kMaxBlocks, ProbeBranching* branching = nullptr);
 
   // Parameters after (or during) a run, for tests: numbered and named (lower case).
   double parameter(int number) const;

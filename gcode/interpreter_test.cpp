@@ -281,6 +281,51 @@ TEST(Interpreter, DeepNestingIsRefusedNotAStackOverflow) {
   EXPECT_EQ(in.parameter(1), 2.0);
 }
 
+// Issue 28: a value that is not a finite number never reaches the machine. Every shape a
+// hostile-input suite found (an overflow to infinity, inf - inf = NaN, a product past the
+// largest double, an offset that overflows the target) stops at its own line, naming what
+// overflowed, with no move made.
+TEST(Interpreter, NonFiniteValuesStopTheProgramAtTheirLine) {
+  const std::string big = "1" + std::string(308, '0');  // 1e308: finite, the largest decade
+  const std::string tan90 = "TAN[90.]";
+  std::string tans = tan90;
+  for (int i = 0; i < 20; ++i) tans += "*" + tan90;  // 1.6e16 ** 21: past the largest double
+  struct Case {
+    ProgramDialect d;
+    std::string program, want;
+  };
+  const std::vector<Case> cases{
+      {ProgramDialect::LinuxCnc, "G0 X0\n#1 = [EXP[1000]]\n#2 = [#1 - #1]\nG0 Z#2\n", "bad.ngc:2: EXP in '#1=[EXP[1000]]' gives an infinite value"},
+      {ProgramDialect::LinuxCnc, "G0 X[" + big + " * 10]\n", "bad.ngc:1: a product in"},
+      {ProgramDialect::LinuxCnc, "#1 = [" + big + " + " + big + "]\n", "bad.ngc:1: a sum in"},
+      {ProgramDialect::LinuxCnc, "#1 = [-" + big + " - " + big + "]\n", "bad.ngc:1: a difference in"},
+      {ProgramDialect::LinuxCnc, "#1 = [" + big + " / 0.1]\n", "bad.ngc:1: a quotient in"},
+      {ProgramDialect::LinuxCnc, "#1 = [10 ** 400]\n", "bad.ngc:1: a power (**) in"},
+      {ProgramDialect::LinuxCnc, "G10 L2 P1 Z" + big + "\nG0 Z" + big + "\n", "bad.ngc:2: the Z target"},
+      {ProgramDialect::LinuxCnc, "G91\nG0 X" + big + "\nG0 X" + big + "\n", "bad.ngc:3: the X target"},
+      {ProgramDialect::FanucMacroB, "#1=EXP[1000.]\n#2=#1-#1\nG0 Z#2\n", "bad.ngc:1: EXP in"},
+      {ProgramDialect::FanucMacroB, "#1=" + tans + "\nG1 Z[#1*0] F100.\n", "bad.ngc:1: a product in"},
+  };
+  for (const auto& c : cases) {
+    Recorder r;
+    Interpreter in(c.d, "bad.ngc", c.program);
+    try {
+      in.run(r);
+      ADD_FAILURE() << "not refused: " << c.program.substr(0, 80);
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(c.want), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("not a finite number"), std::string::npos) << e.what();
+    }
+    for (const auto& t : r.targets) EXPECT_TRUE(t.xyz_mm.allFinite() && std::isfinite(t.c_deg) && std::isfinite(t.b_deg));
+  }
+  // The largest finite values still compute: 1e308 is a value, only its overflow is refused.
+  Recorder r;
+  Interpreter ok(ProgramDialect::LinuxCnc, "ok.ngc", "#1 = [" + big + " * 1.5]\n#2 = [EXP[700]]\nM2\n");
+  ok.run(r);
+  EXPECT_EQ(ok.parameter(1), 1e308 * 1.5);
+  EXPECT_EQ(ok.parameter(2), std::exp(700.0));
+}
+
 TEST(Interpreter, AnEndlessLoopIsStoppedAndNamed) {
   Recorder r;
   Interpreter in(ProgramDialect::LinuxCnc, "loop.ngc", "o1 while [1]\no1 endwhile\n");

@@ -575,6 +575,12 @@ bool looksLikeQif(const std::string& text) {
       if (p == std::string::npos) return false;
       p += 3;
     } else if (text.compare(p, 2, "<?") == 0 || text.compare(p, 2, "<!") == 0) {
+      // A DOCTYPE's internal subset ([ ... ]) holds '>' of its own declarations.
+      const std::size_t gt = text.find('>', p), bracket = text.find('[', p);
+      if (text.compare(p, 9, "<!DOCTYPE") == 0 && bracket != std::string::npos && bracket < gt) {
+        p = text.find("]", bracket);
+        if (p == std::string::npos) return false;
+      }
       p = text.find('>', p);
       if (p == std::string::npos) return false;
       ++p;

@@ -6,17 +6,14 @@
 #include <sstream>
 
 #include "core/csv.hpp"
+#include "core/input_file.hpp"
 #include "core/error.hpp"
 
 namespace probeloop::model {
 namespace {
 
 CsvTable readTable(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, 0, "cannot open the file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  CsvTable t = parseCsv(ss.str(), path);
+  CsvTable t = parseCsv(readFile(path), path);
   if (t.header.empty()) throw InputError(path, 0, "no header line: expected time_s and the data columns");
   if (t.header[0] != "time_s")
     throw InputError(path, t.header_line, "the first column must be time_s, found '" + t.header[0] + "'");

@@ -97,3 +97,47 @@ TEST(Machine, YamlSyntaxErrorHasLine) {
     EXPECT_NE(std::string(e.what()).find("bad.yaml:"), std::string::npos) << e.what();
   }
 }
+
+// Issue 28: yaml-cpp keeps both entries of a key written twice and returns the first; a
+// hand-edited `diameter: 3000 mm` below `diameter: 30 mm` was silently ignored.
+TEST(SphereArtifact, AKeyWrittenTwiceIsRefusedWithBothLines) {
+  const auto m = artifactError("  diameter: 30 mm", "  diameter: 30 mm\n  diameter: 3000 mm");
+  EXPECT_NE(m.find("artifact.yaml:6: key 'diameter' is written twice (lines 5 and 6)"), std::string::npos) << m;
+  // At the top level, and in a list of mappings too.
+  const auto top = artifactError("kind: sphere_artifact", "kind: sphere_artifact\nkind: sphere_artifact");
+  EXPECT_NE(top.find("key 'kind' is written twice (lines 3 and 4)"), std::string::npos) << top;
+}
+
+TEST(Machine, AnAliasUsedAsAKeyNamesTheFile) {
+  // yaml-cpp marks an alias with the line of the node it names (2), not of its use (3).
+  const auto p = writeTemp("alias.yaml", "kind: machine\nbase: &b {x: 1}\n*b : 2\n");
+  try {
+    loadMachine(p);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("alias.yaml:2: a key must be a plain name; found a mapping"), std::string::npos)
+        << e.what();
+  }
+  // An alias bomb (each level doubles the last) is refused, not walked for ever.
+  std::string bomb = "kind: machine\na0: &a0 [x, x]\n";
+  for (int i = 1; i < 40; ++i)
+    bomb += "a" + std::to_string(i) + ": &a" + std::to_string(i) + " [*a" + std::to_string(i - 1) + ", *a" +
+            std::to_string(i - 1) + "]\n";
+  const auto q = writeTemp("bomb.yaml", bomb);
+  try {
+    loadMachine(q);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("expands to more than 1000000 nodes"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Machine, AFileOfAnotherKindIsNamedWhenItIsNotYaml) {
+  const auto p = writeTemp("plan.yaml", "<?xml version=\"1.0\"?>\n<QIFDocument>\n  <a>: b\n  c: [</a>\n</QIFDocument>\n");
+  try {
+    loadMachine(p);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("looks like a QIF (XML) document, not YAML"), std::string::npos) << e.what();
+  }
+}

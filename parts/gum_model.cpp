@@ -113,7 +113,7 @@ std::string caret(const std::string& file_text, int line, int file_column, const
 }  // namespace
 
 uncertainty::TextModel loadGumModel(const std::string& path) {
-  const std::string text = readFile(path);
+  const std::string text = readFile(path, kYamlInput);
   YamlMap root(loadYamlFile(path), path, "");
   root.choice("kind", {"gum_model"});
   uncertainty::TextModel m;

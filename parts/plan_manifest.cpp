@@ -389,9 +389,12 @@ void readGeneric(const ordered_json& j, PlanManifest& m) {
 PlanManifest readManifest(const std::string& path) {
   ordered_json j;
   try {
-    j = ordered_json::parse(readFile(path));
+    j = ordered_json::parse(readFile(path, kJsonInput));
   } catch (const ordered_json::parse_error& e) {
-    throw InputError(path, 0, std::string("not valid JSON: ") + e.what());
+    const std::string kind = describeContent(readFile(path, kJsonInput));
+    throw InputError(path, 0, "not a plan manifest: " + (kind.empty() ? std::string("not valid JSON (") + e.what() + ")"
+                                                                      : "the file looks like " + kind +
+                                                                            "; the manifest is the plan.json that `probeloop plan` writes"));
   }
   PlanManifest m;
   m.file = path;

@@ -3,6 +3,7 @@
 #include "core/csv.hpp"
 
 #include <fstream>
+#include <map>
 #include <stdexcept>
 
 #include "core/atomic_file.hpp"
@@ -10,13 +11,64 @@
 
 namespace probeloop::parts {
 
-YAML::Node loadYamlFile(const std::string& path) {
-  const std::string text = readFile(path);
-  try {
-    return YAML::Load(text);
-  } catch (const YAML::ParserException& e) {
-    throw InputError(path, e.mark.line + 1, "YAML syntax: " + e.msg);
+namespace {
+
+// yaml-cpp keeps both entries of a key written twice and its look-up returns the first, so a
+// hand-edited `diameter: 3000 mm` below `diameter: 30 mm` would be ignored without a word.
+// Every mapping is walked once after loading: keys must be plain scalars (not an alias of a
+// mapping, not a complex key) and appear once. Aliases are followed, within a budget, so that
+// an alias bomb is refused instead of walked for ever.
+class KeyCheck {
+ public:
+  explicit KeyCheck(const std::string& file) : file_(file) {}
+  void walk(const YAML::Node& n, int depth) {
+    if (++visits_ > kMaxVisits)
+      throw InputError(file_, n.Mark().line + 1, "the document expands to more than " + std::to_string(kMaxVisits) +
+                                                     " nodes (aliases of aliases?): not read");
+    if (depth > kMaxDepth)
+      throw InputError(file_, n.Mark().line + 1, "nested more than " + std::to_string(kMaxDepth) + " levels deep: not read");
+    if (n.IsSequence()) {
+      for (const auto& item : n) walk(item, depth + 1);
+      return;
+    }
+    if (!n.IsMap()) return;
+    std::map<std::string, int> seen;
+    for (const auto& kv : n) {
+      const int line = kv.first.Mark().line + 1;
+      if (!kv.first.IsScalar())
+        throw InputError(file_, line, "a key must be a plain name; found a " +
+                                          std::string(kv.first.IsMap() ? "mapping" : kv.first.IsSequence() ? "list" : "null") +
+                                          " (an alias or a complex key?)");
+      const auto [it, fresh] = seen.emplace(kv.first.Scalar(), line);
+      if (!fresh)
+        throw InputError(file_, line, "key '" + kv.first.Scalar() + "' is written twice (lines " + std::to_string(it->second) +
+                                          " and " + std::to_string(line) + "); give it once");
+      walk(kv.second, depth + 1);
+    }
   }
+
+ private:
+  static constexpr long kMaxVisits = 1'000'000;
+  static constexpr int kMaxDepth = 200;
+  const std::string& file_;
+  long visits_ = 0;
+};
+
+}  // namespace
+
+YAML::Node loadYamlFile(const std::string& path) {
+  const std::string text = readFile(path, kYamlInput);
+  YAML::Node doc;
+  try {
+    doc = YAML::Load(text);
+  } catch (const YAML::ParserException& e) {
+    std::string hint;
+    const std::string kind = describeContent(text);
+    if (!kind.empty() && kind.find("YAML") == std::string::npos) hint = " (the file looks like " + kind + ", not YAML)";
+    throw InputError(path, e.mark.line + 1, "YAML syntax: " + e.msg + hint);
+  }
+  KeyCheck(path).walk(doc, 0);
+  return doc;
 }
 
 YamlMap::YamlMap(const YAML::Node& node, std::string file, std::string path)

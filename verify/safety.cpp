@@ -242,7 +242,7 @@ struct Interrupted {
   std::string event;
 };
 
-class Checker : public gcode::MachineInterface {
+class Checker : public gcode::MachineInterface, public gcode::ProbeBranching {
  public:
   Checker(const parts::Machine& m, const parts::TestPiece& piece, const Options& o) : m_(m), o_(o) {
     buildTools(piece);
@@ -256,65 +256,97 @@ class Checker : public gcode::MachineInterface {
   const Scene& scene() const { return scene_; }
   const std::map<int, Tool>& tools() const { return tools_; }
 
-  // State a program starts from (restored before each what-if run).
+  // The machine's state (restored after each probe branch).
   struct State {
     gcode::MachinePosition pos;
     int tool = 0;
     double rpm = 0;
+    int line = 0;
   };
-  State state() const { return {pos_, tool_, rpm_}; }
+  State state() const { return {pos_, tool_, rpm_, line_}; }
   void restore(const State& s) {
     pos_ = s.pos;
     tool_ = s.tool;
     rpm_ = s.rpm;
+    line_ = s.line;
   }
 
-  // Nominal run: probe outcomes recorded. What-if run: replayed, the one at `flip` inverted;
-  // after it, the first event that is not a stop interrupts the run.
-  void nominal() {
-    replay_ = false;
-    outcomes_.clear();
-    probe_lines_.clear();
-    probe_tips_.clear();
+  // A probe move whose other outcome does not stop the program: what the program went on to.
+  struct Unprotected {
+    int line = 0;
+    long probe = 0;  // index of the probe move in the program's run
+    bool contact = false;  // the nominal outcome
+    std::string went_on;
+    Vector3d tip = Vector3d::Zero();
+  };
+  // Starts a program's run: the probe lines branched so far are forgotten.
+  void startProgram() {
+    branched_lines_.clear();
+    unprotected_.clear();
+    probes_ = 0;
   }
-  void whatIf(std::size_t flip) {
+  const std::vector<Unprotected>& unprotected() const { return unprotected_; }
+  long probes() const { return probes_; }
+
+  // --- ProbeBranching: protection ---
+  // Each probe line's first execution, with its outcome inverted, must stop the program before
+  // anything else happens: the branch runs on from the probe move (the interpreter's state
+  // copied there), and the first event that is not a stop interrupts it. One run of the
+  // program and one short branch per probe line: linear in the program's length.
+  void atProbe(const gcode::ProbeOutcome& nominal, const RunWith& run_with) override {
+    if (!branched_lines_.insert(line_).second) return;
+    gcode::ProbeOutcome other = nominal;
+    if (nominal.contact) {
+      other.contact = false;
+      other.stop = probe_to_;
+    } else {
+      other.contact = true;
+      other.stop = probe_from_;
+      other.stop.xyz_mm = probe_from_.xyz_mm + 0.5 * (probe_to_.xyz_mm - probe_from_.xyz_mm);
+    }
+    const State saved = state();
+    Unprotected u{line_, probes_ - 1, nominal.contact, "", tip(nominal.stop)};
+    bool stopped = false;
     replay_ = true;
-    flip_ = flip;
-    flipped_ = false;
-    count_ = 0;
+    pos_ = other.stop;
+    try {
+      run_with(other);
+      u.went_on = "the program's end";
+    } catch (const Interrupted& i) {
+      u.went_on = i.event;
+    } catch (const SafetyError&) {
+      stopped = true;
+    } catch (...) {
+      replay_ = false;
+      restore(saved);
+      throw;
+    }
+    replay_ = false;
+    restore(saved);
+    if (!stopped) unprotected_.push_back(std::move(u));
   }
-  bool flipped() const { return flipped_; }
-  const std::vector<int>& probeLines() const { return probe_lines_; }
-  const std::vector<gcode::ProbeOutcome>& outcomes() const { return outcomes_; }
-  const std::vector<Vector3d>& probeTips() const { return probe_tips_; }
+
+  // A coordinate that is not a number compares false with every limit: a move to it is never
+  // checked, it is refused (the interpreter refuses it first; this is the second guard). The
+  // interpreter adds the file:line, and `check` exits 2: the program cannot be evaluated.
+  static const gcode::MachinePosition& requireFinite(const gcode::MachinePosition& to) {
+    if (!to.xyz_mm.allFinite() || !std::isfinite(to.b_deg) || !std::isfinite(to.c_deg))
+      throw InputError("", 0, "a move to a coordinate that is not a finite number: the program cannot be checked");
+    return to;
+  }
 
   // --- MachineInterface ---
   gcode::MachinePosition start() const override { return pos_; }
   void atLine(int line) override { line_ = line; }
-  void rapid(const gcode::MachinePosition& to) override { move(to, false, 0); }
-  void feed(const gcode::MachinePosition& to, double f) override { move(to, true, f); }
+  void rapid(const gcode::MachinePosition& to) override { move(requireFinite(to), false, 0); }
+  void feed(const gcode::MachinePosition& to, double f) override { move(requireFinite(to), true, f); }
   gcode::ProbeOutcome probe(const gcode::MachinePosition& to, double, gcode::ProbeMode) override {
+    requireFinite(to);
     event("a probe move");
-    if (replay_) {
-      gcode::ProbeOutcome r = outcomes_.at(count_);
-      if (count_++ == flip_) {
-        flipped_ = true;
-        if (r.contact) {
-          r.contact = false;
-          r.stop = to;
-        } else {
-          r.contact = true;
-          r.stop = pos_;
-          r.stop.xyz_mm = pos_.xyz_mm + 0.5 * (to.xyz_mm - pos_.xyz_mm);
-        }
-      }
-      pos_ = r.stop;
-      return r;
-    }
     const auto r = probeNominal(to);
-    outcomes_.push_back(r);
-    probe_lines_.push_back(line_);
-    probe_tips_.push_back(tip(r.stop));
+    ++probes_;
+    probe_from_ = pos_;
+    probe_to_ = to;
     pos_ = r.stop;
     return r;
   }
@@ -360,18 +392,19 @@ class Checker : public gcode::MachineInterface {
   int tool_ = -1;  // unknown at the start: nothing in the spindle is assumed
   double rpm_ = 0;
   int line_ = 0;
-  bool replay_ = false, flipped_ = false;
-  std::size_t flip_ = 0, count_ = 0;
-  std::vector<gcode::ProbeOutcome> outcomes_;
-  std::vector<int> probe_lines_;
-  std::vector<Vector3d> probe_tips_;  // where each probe move stopped (tip, machine coordinates)
+  // In a probe branch (after the inverted outcome): nothing is checked, the first event stops it.
+  bool replay_ = false;
+  long probes_ = 0;  // probe moves of this program's run so far
+  gcode::MachinePosition probe_from_, probe_to_;  // the last probe move
+  std::set<int> branched_lines_;
+  std::vector<Unprotected> unprotected_;
   mutable long envelope_version_ = -1;  // the bodies' circle, for this state of the material
   mutable double envelope_ = 0;
   std::set<std::tuple<std::string, int, std::string>> seen_;
   std::set<std::tuple<double, double, double, int, long, double, double>> turned_;  // rotary sweeps already checked
 
   void event(const std::string& what) {
-    if (replay_ && flipped_) throw Interrupted{what};
+    if (replay_) throw Interrupted{what};
   }
 
   const Tool& toolOf(int n) const {
@@ -741,56 +774,30 @@ Report checkPrograms(const std::vector<ProgramText>& programs, const parts::Mach
     rep.programs.push_back(p.file);
     ck.file = p.file;
     const auto dialect = dialectOf(p.file, machine);
-    const Checker::State start = ck.state();
-    ck.nominal();
+    ck.startProgram();
     bool stopped_nominal = false;
-    // Parsed once; every run (the nominal one, one per probe line with its outcome inverted)
-    // starts from a copy, with the parameters as they are before the program.
-    const gcode::Interpreter parsed(dialect, p.file, p.text);
     try {
-      gcode::Interpreter in = parsed;
-      in.run(ck);
+      gcode::Interpreter in(dialect, p.file, p.text);
+      in.run(ck, gcode::Interpreter::kMaxBlocks, &ck);
     } catch (const SafetyError& e) {
       stopped_nominal = true;
       const auto [line, what] = located(p.file, e.what());
       ck.addAt(line, "program-stops", "the program stops here on the nominal part: " + what, ck.tip(ck.start()),
                "a program runs to its end when nothing is out of place");
     }
-    const Checker::State end = ck.state();
     // Protection: each probe line's first move with its outcome inverted must stop the program
-    // before anything else happens.
-    const auto lines = ck.probeLines();
-    const auto outcomes = ck.outcomes();
-    const auto tips = ck.probeTips();
-    std::set<int> done;
-    for (std::size_t k = 0; k < lines.size(); ++k) {
+    // before anything else happens (tried in the run, ProbeBranching above).
+    for (const auto& u : ck.unprotected()) {
       // A program that stopped on its last probe move: that move's outcome was already the
       // unexpected one (its finding is program-stops).
-      if (stopped_nominal && k + 1 == lines.size()) break;
-      if (!done.insert(lines[k]).second) continue;
-      ck.restore(start);
-      ck.whatIf(k);
-      std::string went_on;
-      bool stopped = false;
-      try {
-        gcode::Interpreter in = parsed;
-        in.run(ck);
-        went_on = "the program's end";
-      } catch (const Interrupted& i) {
-        went_on = i.event;
-      } catch (const SafetyError&) {
-        stopped = ck.flipped();
-      }
-      if (stopped || !ck.flipped()) continue;
-      const bool contact = outcomes[k].contact;
-      ck.addAt(lines[k], "probe-unprotected",
-               contact ? "measuring move: when the probe does not trigger the program goes on to " + went_on + " instead of stopping"
-                       : "positioning probe move: when the probe touches something the program goes on to " + went_on +
-                             " instead of stopping",
-               tips[k], contact ? "no contact -> error (G38.2, or G31 with a check and #3000)"
-                                                : "contact -> ABORT / #3000 (G38.3 + #5070 check, or G31 with a check)");
+      if (stopped_nominal && u.probe + 1 == ck.probes()) continue;
+      ck.addAt(u.line, "probe-unprotected",
+               u.contact ? "measuring move: when the probe does not trigger the program goes on to " + u.went_on + " instead of stopping"
+                         : "positioning probe move: when the probe touches something the program goes on to " + u.went_on +
+                               " instead of stopping",
+               u.tip, u.contact ? "no contact -> error (G38.2, or G31 with a check and #3000)"
+                                : "contact -> ABORT / #3000 (G38.3 + #5070 check, or G31 with a check)");
     }
-    ck.restore(end);
   }
   rep.findings = ck.findings;
   std::stable_sort(rep.findings.begin(), rep.findings.end(), [&](const Finding& a, const Finding& b) {

@@ -212,6 +212,40 @@ lines.insert(i + 1, "G0 X0 Q5")
 open(f"{W}/bad_word.ngc", "w").write("\n".join(lines))
 code, o, e = run("check", f"{W}/bad_word.ngc", "--machine", MACHINES["linuxcnc_rotary_mill"], "--part", PIECES["sphere"])
 check("a word the interpreter does not model: exit 2 with file:line", code == 2 and f"bad_word.ngc:{i + 2}:" in e, e)
+# --- 5. programs that compute a coordinate that is not a number (issue 28) -------------------------
+# Before: an overflow to infinity, inf - inf = NaN, a move to it, then an ordinary rapid into the
+# stock passed as "safe: 0 findings" (a NaN compares false with every limit). Now the program
+# cannot be evaluated: exit 2 naming the line and the expression, never "safe".
+BIG = "1" + "0" * 308  # 1e308: finite; ten times it is not
+nonfinite = [
+    # (name, source program, inserted lines after the probe comes in, the line (offset) refused, text)
+    ("nan_then_rapid_into_sphere", f"{sphere_lc}/sphere_cycle.ngc", "G43 H99",
+     ["#901 = [EXP[1000]]", "#902 = [#901 - #901]", "G0 Z#902", "G0 Z80.0000"], 1, "EXP in"),
+    ("overflowing_coordinate", f"{sphere_lc}/sphere_cycle.ngc", "G43 H99", [f"G0 Z[{BIG} * 10]"], 1, "a product in"),
+    ("nan_plunge_fanuc", f"{sphere_fa}/sphere_cycle.nc", "G43 H99",
+     ["#901=EXP[1000.]", "#902=#901-#901", "G1 Z#902 F100."], 1, "EXP in"),
+    ("offset_overflow_fanuc", f"{sphere_fa}/sphere_cycle.nc", "G43 H99",
+     [f"#901={BIG}.", "G0 X[#901+#901]"], 2, "a sum in"),
+]
+for name, src, after, insert, bad, text in nonfinite:
+    lines = open(src).read().split("\n")
+    i = first(lines, after)
+    lines[i + 1:i + 1] = insert
+    path = f"{W}/{name}" + os.path.splitext(src)[1]
+    open(path, "w").write("\n".join(lines))
+    machine = "linuxcnc_rotary_mill" if src.endswith(".ngc") else "nmv5000"
+    code, o, e = run("check", path, "--machine", MACHINES[machine], "--part", PIECES["sphere"])
+    check(f"{name}: exit 2 at line {i + 1 + bad} ({text.strip()}), not 'safe'",
+          code == 2 and f"{os.path.basename(path)}:{i + 1 + bad}: {text}" in e and "not a finite number" in e
+          and "safe" not in o, (code, o[:300], e[:600]))
+# The same rapid into the sphere without the NaN move before it is a collision (exit 3): the NaN
+# used to hide it.
+lines = open(f"{sphere_lc}/sphere_cycle.ngc").read().split("\n")
+i = first(lines, "G43 H99")
+lines[i + 1:i + 1] = ["G0 Z80.0000"]
+open(f"{W}/rapid_only.ngc", "w").write("\n".join(lines))
+code, o, e = run("check", f"{W}/rapid_only.ngc", "--machine", MACHINES["linuxcnc_rotary_mill"], "--part", PIECES["sphere"])
+check("the rapid alone: a finding (exit 3)", code == 3 and "UNSAFE" in o, (code, o[:400]))
 print(f"     {time.time() - t0:.1f} s")
 if not check.failed:
     shutil.rmtree(W, ignore_errors=True)  # kept on failure, for a look at the edited programs
