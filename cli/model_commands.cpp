@@ -18,7 +18,7 @@
 #include "model/outputs.hpp"
 #include "model/talc.hpp"
 #include "parts/error_model_file.hpp"
-#include "parts/test_piece.hpp"
+#include "parts/piece_kinds.hpp"
 #include "report/model_report.hpp"
 
 namespace probeloop::cli {

@@ -3,7 +3,7 @@
 //
 // Contract:
 // - csv: a header row; coordinates from columns x_mm,y_mm,z_mm (or x,y,z); optional unit
-//   approach directions nx,ny,nz (the canonical points CSV of DESIGN §3 qualifies; its
+//   approach directions nx,ny,nz (the canonical points CSV of docs/architecture.md#data-contracts qualifies; its
 //   other columns are ignored, and `feature` selects rows when a feature is asked for).
 // - ds: NIST algorithm-testing format, first line N, then N lines "x y z".
 // - xyz: one point per line, >= 3 numbers separated by blanks or commas, '#' comments;

@@ -82,7 +82,7 @@ CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& manifest,
                                           const std::vector<ProbeRecord>& records,
                                           const EvaluateOptions& options = {});
 
-// Error series CSV (DESIGN.md §3): time_s,cycle,<7 errors>,U_<7 errors>.
+// Error series CSV (docs/architecture.md#data-contracts): time_s,cycle,<7 errors>,U_<7 errors>.
 std::string errorSeriesCsv(const CampaignEvaluation& e);
 std::string evaluationJson(const CampaignEvaluation& e, const parts::PlanManifest& m);
 // A Markdown report: the range of U per error, the full budgets of the last cycle, the

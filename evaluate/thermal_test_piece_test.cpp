@@ -12,7 +12,7 @@
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
-#include "evaluate/test_piece.hpp"
+#include "evaluate/piece_evaluation.hpp"
 #include "evaluate/thermal_test_piece.hpp"
 #include "evaluate/ttp_ingest.hpp"
 #include "evaluate/ttp_test_support.hpp"

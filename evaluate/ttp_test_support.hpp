@@ -16,7 +16,7 @@
 #include "core/csv.hpp"
 #include "core/units.hpp"
 #include "parts/plan_manifest.hpp"
-#include "parts/test_piece.hpp"
+#include "parts/piece_kinds.hpp"
 #include "parts/thermal_test_piece.hpp"
 
 namespace probeloop::evaluate::ttptest {

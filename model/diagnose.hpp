@@ -1,4 +1,4 @@
-// Where an error model fails and which effect is missing (DESIGN.md §6; issue 5).
+// Where an error model fails and which effect is missing (docs/architecture.md#what-probeloop-is; issue 5).
 //
 // Per channel: the residual (measured - model) against the measurement's uncertainty, its
 // whiteness (Ljung-Box on the training residual), the time windows where |residual| > U of

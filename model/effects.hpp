@@ -1,4 +1,4 @@
-// The effects library (DESIGN.md §5): the physical error effects, written once, used as
+// The effects library (docs/architecture.md#how-to-add-an-effect): the physical error effects, written once, used as
 // truth by the simulator (sim/) and as model terms and diagnosis candidates here.
 //
 // Two layers:

@@ -1,4 +1,4 @@
-// An error model: the effects of each error channel (DESIGN.md §5), as written in a model
+// An error model: the effects of each error channel (docs/architecture.md#how-to-add-an-effect), as written in a model
 // file (YAML, kind: error_model; docs/formats.md#error-model; loaded by parts/).
 //
 // Every channel has an offset implicitly: the errors are relative to a reference cycle, and

@@ -1,4 +1,4 @@
-// Identification of an error model on a campaign (seed 004 Ch. 4, DESIGN.md §6).
+// Identification of an error model on a campaign (seed 004 Ch. 4; docs/architecture.md#what-probeloop-is).
 //
 // Per channel: y = c + sum_j k_j r_j(t; tau_j) + fixed(t), where r_j is the regressor of a
 // fitted effect (model/effects.hpp) interpolated at the error times and fixed(t) the known

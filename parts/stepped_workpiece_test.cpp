@@ -12,7 +12,7 @@
 #include <unistd.h>
 
 #include "core/error.hpp"
-#include "parts/test_piece.hpp"
+#include "parts/piece_kinds.hpp"
 #include "parts/test_support.hpp"
 
 namespace probeloop::parts {

@@ -14,7 +14,7 @@
 #include "core/error.hpp"
 #include "core/units.hpp"
 #include "parts/plan_manifest.hpp"
-#include "parts/test_piece.hpp"
+#include "parts/piece_kinds.hpp"
 #include "parts/test_support.hpp"
 #include "parts/thermal_test_piece.hpp"
 

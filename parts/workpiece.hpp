@@ -1,7 +1,7 @@
 // A workpiece to machine on the table (YAML, kind: workpiece; docs/formats.md#workpiece):
 // the stock, its material, the cutting tools, and the CMM that inspects it afterwards. Test
 // pieces that are machined (kind: thermal_test_piece, ...) build one of these from their own
-// description (parts/test_piece.hpp).
+// description (parts/piece_kinds.hpp).
 //
 // Frames: the stock, holes and collision bodies are given in the *part frame*. The part
 // frame sits on the table with its axes parallel to the machine's at C = 0 and its origin at

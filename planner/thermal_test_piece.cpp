@@ -9,7 +9,7 @@
 #include "core/csv.hpp"
 #include "core/error.hpp"
 #include "core/units.hpp"
-#include "parts/test_piece.hpp"
+#include "parts/piece_kinds.hpp"
 #include "planner/angles.hpp"
 #include "planner/piece_manifest.hpp"
 

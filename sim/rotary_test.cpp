@@ -11,7 +11,7 @@
 #include "core/csv.hpp"
 #include "core/error.hpp"
 #include "core/units.hpp"
-#include "parts/test_piece.hpp"
+#include "parts/piece_kinds.hpp"
 #include "sim/test_support.hpp"
 #include "sim/virtual_machine.hpp"
 

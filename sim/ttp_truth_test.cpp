@@ -19,7 +19,7 @@
 
 #include "core/csv.hpp"
 #include "core/units.hpp"
-#include "parts/test_piece.hpp"
+#include "parts/piece_kinds.hpp"
 #include "sim/test_support.hpp"
 #include "sim/virtual_machine.hpp"
 

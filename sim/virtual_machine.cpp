@@ -20,7 +20,7 @@
 #include "model/effects.hpp"
 #include "sim/material_removal.hpp"
 #include "sim/random_streams.hpp"
-#include "sim/test_piece_truth.hpp"
+#include "sim/piece_truth.hpp"
 
 namespace probeloop::sim {
 

@@ -43,7 +43,7 @@
 #include "gcode/interpreter.hpp"
 #include "parts/machine.hpp"
 #include "parts/sphere_artifact.hpp"
-#include "parts/test_piece.hpp"
+#include "parts/piece_kinds.hpp"
 #include "parts/workpiece.hpp"
 #include "sim/cmm_stage.hpp"
 #include "sim/machine_truth.hpp"
@@ -73,7 +73,7 @@ struct SimulationOutputs {
 };
 
 // What stands on the table: a sphere artifact, a workpiece, or a test piece (exactly one).
-// A test piece (parts/test_piece.hpp) stands as its kind says: a sphere artifact as the
+// A test piece (parts/piece_kinds.hpp) stands as its kind says: a sphere artifact as the
 // artifact; a machined one (thermal test piece, plain workpiece) as its stock placed on the
 // machine by placeOnMachine; for a thermal test piece truth.json then also holds the as-cut
 // surfaces, the datum frame and E_X ... E_TTP per cutting cycle (docs/simulator.md §3.1).

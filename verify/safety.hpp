@@ -44,7 +44,7 @@
 #include <vector>
 
 #include "parts/machine.hpp"
-#include "parts/test_piece.hpp"
+#include "parts/piece_kinds.hpp"
 
 namespace probeloop::verify {
 

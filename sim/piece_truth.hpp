@@ -35,7 +35,7 @@
 #include <string>
 #include <vector>
 
-#include "parts/test_piece.hpp"
+#include "parts/piece_kinds.hpp"
 #include "parts/thermal_test_piece.hpp"
 #include "sim/material_removal.hpp"
 

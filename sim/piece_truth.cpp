@@ -1,4 +1,4 @@
-#include "sim/test_piece_truth.hpp"
+#include "sim/piece_truth.hpp"
 
 #include <algorithm>
 #include <cmath>

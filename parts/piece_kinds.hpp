@@ -1,4 +1,4 @@
-// Test pieces as data (DESIGN.md §9): every kind of test piece - the sphere artifact, the
+// Test pieces as data (docs/architecture.md#how-to-add-a-test-piece): every kind of test piece - the sphere artifact, the
 // thermal test piece, a plain workpiece for a program of one's own, and whatever comes next -
 // is loaded into this one model, which the layers below read: the planner turns it into
 // programs and a manifest, the simulator machines and measures it, the evaluation fits its

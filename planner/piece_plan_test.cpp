@@ -1,5 +1,5 @@
-// The kind dispatch every `probeloop plan` goes through (planner/test_piece.hpp).
-#include "planner/test_piece.hpp"
+// The kind dispatch every `probeloop plan` goes through (planner/piece_plan.hpp).
+#include "planner/piece_plan.hpp"
 
 #include <gtest/gtest.h>
 

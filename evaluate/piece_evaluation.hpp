@@ -3,8 +3,9 @@
 // stdout_text. No mathematics in the CLI.
 //
 // Kinds: sphere_artifact (seed 004 Ch. 5: evaluate/sphere_campaign.hpp; the writers of
-// evaluate/outputs.cpp, as before the dispatch) and thermal_test_piece (seed 004 Ch. 7:
-// evaluate/thermal_test_piece.hpp).
+// evaluate/outputs.cpp, as before the dispatch), thermal_test_piece (seed 004 Ch. 7:
+// evaluate/thermal_test_piece.hpp) and stepped_workpiece (seed 000: its CMM export and probe
+// log together, evaluate/stepped_workpiece.hpp).
 #pragma once
 #include <optional>
 #include <string>
@@ -43,8 +44,8 @@ struct EvaluationFiles {
   std::optional<SwEvaluation> stepped_workpiece;
 };
 
-// InputError for bad input (file, line, feature, what was expected); kinds other than the two
-// above are refused naming the manifest.
+// InputError for bad input (file, line, feature, what was expected); kinds other than the
+// three above are refused naming the manifest.
 EvaluationFiles evaluateTestPiece(const parts::PlanManifest& manifest, const EvaluateRequest& request);
 
 // The sphere campaign's summary as `probeloop evaluate` has always printed it (without the

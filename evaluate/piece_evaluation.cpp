@@ -1,4 +1,4 @@
-#include "evaluate/test_piece.hpp"
+#include "evaluate/piece_evaluation.hpp"
 
 #include <cmath>
 #include <cstdarg>
@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 
+#include "core/paths.hpp"
 #include "core/atomic_file.hpp"
 #include "evaluate/qif_results.hpp"
 #include "core/csv.hpp"
@@ -33,8 +34,6 @@ void appendf(std::string& out, const char* fmt, ...) {
   }
   va_end(ap2);
 }
-
-std::string join(const std::string& dir, const std::string& file) { return (std::filesystem::path(dir) / file).string(); }
 
 EvaluationFiles sphere(const parts::PlanManifest& planned, const EvaluateRequest& r) {
   parts::PlanManifest m = planned;
@@ -79,8 +78,8 @@ EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateReq
   f.results_qif = evaluationQif(m, points ? &*points : nullptr, f.errors_csv);
   f.evaluation_json = ttpEvaluationJson(e);
   f.report_md = ttpReport(e);
-  f.stdout_text = ttpStdout(e, join(r.out_dir, EvaluationFiles::kErrorsCsv), join(r.out_dir, EvaluationFiles::kEvaluationJson),
-                            join(r.out_dir, EvaluationFiles::kReportMd));
+  f.stdout_text = ttpStdout(e, pathIn(r.out_dir, EvaluationFiles::kErrorsCsv), pathIn(r.out_dir, EvaluationFiles::kEvaluationJson),
+                            pathIn(r.out_dir, EvaluationFiles::kReportMd));
   f.thermal_test_piece = std::move(e);
   return f;
 }
@@ -137,7 +136,7 @@ EvaluationFiles evaluateByKind(const parts::PlanManifest& m, const EvaluateReque
 
 EvaluationFiles evaluateTestPiece(const parts::PlanManifest& m, const EvaluateRequest& r) {
   auto f = evaluateByKind(m, r);
-  if (!f.results_qif.empty()) f.stdout_text += "  the results as QIF 3.0: " + join(r.out_dir, EvaluationFiles::kResultsQif) + "\n";
+  if (!f.results_qif.empty()) f.stdout_text += "  the results as QIF 3.0: " + pathIn(r.out_dir, EvaluationFiles::kResultsQif) + "\n";
   return f;
 }
 
@@ -160,8 +159,8 @@ std::string sphereEvaluationStdout(const CampaignEvaluation& e, const std::strin
             e.formula_positions[1], e.formula_positions[2], e.formula_positions[3], worst);
   }
   for (const auto& [c, why] : e.incomplete) appendf(o, "Cycle %d not evaluated: %s\n", c, why.c_str());
-  appendf(o, "Wrote %s, %s (budgets) and %s (report)\n", join(out_dir, EvaluationFiles::kErrorsCsv).c_str(),
-          join(out_dir, EvaluationFiles::kEvaluationJson).c_str(), join(out_dir, EvaluationFiles::kReportMd).c_str());
+  appendf(o, "Wrote %s, %s (budgets) and %s (report)\n", pathIn(out_dir, EvaluationFiles::kErrorsCsv).c_str(),
+          pathIn(out_dir, EvaluationFiles::kEvaluationJson).c_str(), pathIn(out_dir, EvaluationFiles::kReportMd).c_str());
   return o;
 }
 

@@ -1,4 +1,4 @@
-#include "parts/test_piece.hpp"
+#include "parts/piece_kinds.hpp"
 
 #include "core/error.hpp"
 #include "core/units.hpp"

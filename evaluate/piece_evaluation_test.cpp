@@ -2,7 +2,7 @@
 // other kind are refused. The sphere artifact's outputs are not compared with earlier ones here or
 // in any automated check (they go through the same writers, evaluate/outputs.cpp; a byte-for-byte
 // comparison with the previous CLI was made by hand when the dispatch was introduced).
-#include "evaluate/test_piece.hpp"
+#include "evaluate/piece_evaluation.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "planner/test_piece.hpp"
+#include "planner/piece_plan.hpp"
 
 #include "planner/cmm_plan.hpp"
 
@@ -8,6 +8,7 @@
 #include <map>
 #include <sstream>
 
+#include "core/paths.hpp"
 #include "core/csv.hpp"
 #include "core/error.hpp"
 #include "planner/sphere_cycle.hpp"
@@ -17,10 +18,6 @@
 namespace probeloop::planner {
 
 namespace {
-
-std::string join(const std::string& dir, const std::string& file) {
-  return (std::filesystem::path(dir) / file).string();
-}
 
 std::string printf1(const char* fmt, double v) {
   char b[128];
@@ -59,13 +56,13 @@ TestPiecePlan sphere(const parts::SphereArtifact& a, const parts::Machine& m, pa
   std::snprintf(line, sizeof line, "Planned %d cycles of the sphere cycle for %s (%s dialect)\n", plan.manifest.cycles,
                 m.name.c_str(), parts::dialectName(dialect));
   s << line;
-  s << "  wrote " << join(out_dir, files.program_file) << " and " << join(out_dir, "plan.json") << "\n";
+  s << "  wrote " << pathIn(out_dir, files.program_file) << " and " << pathIn(out_dir, "plan.json") << "\n";
   s << printf1("Estimated cycle time %.1f s (seed 004: 95 s incl. two tool changes):\n", t.total());
   s << printf1("  tool changes %6.1f s\n", t.tool_change_s) << printf1("  C indexing   %6.1f s\n", t.c_index_s)
     << printf1("  rapids       %6.1f s\n", t.rapid_s) << printf1("  protected    %6.1f s\n", t.protected_s)
     << printf1("  probing      %6.1f s\n", t.probing_s);
   s << "  (no acceleration; see docs/sphere-cycle.md for the comparison with 95 s)\n";
-  s << "  the probing plan as QIF 3.0: " << join(out_dir, kQifProbePlanFile) << "\n";
+  s << "  the probing plan as QIF 3.0: " << pathIn(out_dir, kQifProbePlanFile) << "\n";
   out.summary = s.str();
   out.manifest = std::move(plan.manifest);
   return out;
@@ -165,9 +162,9 @@ TestPiecePlan thermal(const parts::TestPiece& piece, const parts::ThermalTestPie
     << "); the CMM measures the same points (" << man.ttp.cmm_plan << ", as QIF 3.0 " << kQifCmmPlanFile << ", as DMIS "
     << kDmisCmmPlanFile << ")\n";
   s << "  wrote";
-  for (const auto& p : out.programs) s << " " << join(out_dir, p.file) << ",";
-  s << " " << join(out_dir, man.ttp.cmm_plan) << ", " << join(out_dir, kQifCmmPlanFile) << ", " << join(out_dir, kDmisCmmPlanFile) << " and "
-    << join(out_dir, "plan.json") << "\n";
+  for (const auto& p : out.programs) s << " " << pathIn(out_dir, p.file) << ",";
+  s << " " << pathIn(out_dir, man.ttp.cmm_plan) << ", " << pathIn(out_dir, kQifCmmPlanFile) << ", " << pathIn(out_dir, kDmisCmmPlanFile) << " and "
+    << pathIn(out_dir, "plan.json") << "\n";
   s << "  (planned with the simulator's clock, no acceleration: docs/simulator.md §2, docs/thermal-test-piece.md §5)\n";
   out.summary = s.str();
   out.manifest = std::move(plan.manifest);
@@ -227,9 +224,9 @@ TestPiecePlan stepped(const parts::SteppedWorkpiece& w, const std::string& exper
       << formatNumber(st.conditions.feed_z_mm_per_min) << " mm/min, " << formatNumber(st.conditions.spindle_speed_rpm)
       << " rpm, cut " << hms(st.start_s) << " - " << hms(st.end_s) << ", T = " << formatNumber(st.temp_state_min, 2) << " min\n";
   s << "  wrote";
-  for (const auto& p : out.programs) s << " " << join(out_dir, p.file) << ",";
-  s << " " << join(out_dir, man.sw.cmm_plan) << ", " << join(out_dir, kQifCmmPlanFile) << ", " << join(out_dir, kDmisCmmPlanFile) << " and "
-    << join(out_dir, "plan.json") << "\n";
+  for (const auto& p : out.programs) s << " " << pathIn(out_dir, p.file) << ",";
+  s << " " << pathIn(out_dir, man.sw.cmm_plan) << ", " << pathIn(out_dir, kQifCmmPlanFile) << ", " << pathIn(out_dir, kDmisCmmPlanFile) << " and "
+    << pathIn(out_dir, "plan.json") << "\n";
   s << "  (planned with the simulator's clock, no acceleration: docs/simulator.md §2, docs/stepped-workpiece.md §4)\n";
   out.summary = s.str();
   out.manifest = std::move(plan.manifest);

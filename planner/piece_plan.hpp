@@ -1,4 +1,4 @@
-// The planner's entry for every kind of test piece (DESIGN.md §9, docs/test-pieces.md):
+// The planner's entry for every kind of test piece (docs/architecture.md#how-to-add-a-test-piece, docs/test-pieces.md):
 // a loaded TestPiece + machine + dialect -> the program texts, the plan manifest, the other
 // files beside it and the summary `probeloop plan` prints.
 //
@@ -18,7 +18,7 @@
 
 #include "parts/machine.hpp"
 #include "parts/plan_manifest.hpp"
-#include "parts/test_piece.hpp"
+#include "parts/piece_kinds.hpp"
 
 namespace probeloop::planner {
 

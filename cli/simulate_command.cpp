@@ -1,0 +1,93 @@
+// `probeloop simulate`: programs run back to back on the virtual machine; its logs, points,
+// inputs, truth, cuts and CMM results written to --out.
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+
+#include "cli/commands.hpp"
+#include "cli/input_option.hpp"
+#include "core/atomic_file.hpp"
+#include "core/paths.hpp"
+#include "parts/machine.hpp"
+#include "parts/piece_kinds.hpp"
+#include "sim/machine_truth.hpp"
+#include "sim/run_inputs.hpp"
+#include "sim/virtual_machine.hpp"
+
+namespace probeloop::cli {
+namespace {
+
+struct SimulateArgs {
+  std::vector<std::string> programs;
+  std::string machine, part, truth, out = ".", cmm_points, schedule;
+  std::uint64_t seed = 1;
+  bool trace = false;
+};
+
+int runSimulate(const SimulateArgs& a) {
+  const auto machine = parts::loadMachine(a.machine);
+  const auto truth = sim::loadMachineTruth(a.truth);
+  const auto piece = parts::loadTestPiece(a.part);
+  sim::SimulationPart part;
+  part.test_piece = &piece;
+  if (!a.cmm_points.empty()) sim::loadCmmRequest(part, a.cmm_points);
+  part.trace = a.trace;
+  std::vector<sim::ProgramSource> programs;
+  for (const auto& f : a.programs) programs.push_back({f, readFile(f, kProgramInput), std::nullopt});
+  if (!a.schedule.empty()) sim::scheduleFromManifest(programs, a.schedule);
+  const auto s = sim::simulatePrograms(programs, machine, part, truth, a.seed);
+  std::string written;
+  for (const auto& l : s.logs) {
+    const std::string name = std::filesystem::path(l.name).filename().string();
+    writeFileAtomic(pathIn(a.out, name), l.text);
+    written += name + " (controller log), ";
+  }
+  writeFileAtomic(pathIn(a.out, "points.csv"), s.points_csv);
+  writeFileAtomic(pathIn(a.out, "inputs.csv"), s.inputs_csv);
+  writeFileAtomic(pathIn(a.out, "truth.json"), s.truth_json);
+  std::string extra;
+  if (!piece.sphereArtifact()) {
+    writeFileAtomic(pathIn(a.out, "cuts.json"), s.cuts_json);
+    extra += ", cuts.json";
+  }
+  if (a.trace) {
+    writeFileAtomic(pathIn(a.out, "trace.csv"), s.trace_csv);
+    extra += ", trace.csv";
+  }
+  if (!s.cmm_csv.empty()) {
+    writeFileAtomic(pathIn(a.out, "cmm_export.csv"), s.cmm_csv);
+    extra += ", cmm_export.csv";
+  }
+  if (!s.cmm_qif.empty()) {
+    writeFileAtomic(pathIn(a.out, "cmm_results.qif"), s.cmm_qif);
+    writeFileAtomic(pathIn(a.out, "cmm_results.dmo"), s.cmm_dmo);
+    extra += ", cmm_results.qif, cmm_results.dmo";
+  }
+  const std::string what = a.programs.size() == 1 ? a.programs.front() : std::to_string(a.programs.size()) + " programs";
+  std::printf("Simulated %s on %s (seed %llu): %ld blocks, %ld probe events, %.1f h of machine time\n", what.c_str(),
+              machine.name.c_str(), static_cast<unsigned long long>(a.seed), s.blocks, s.probe_events, s.end_time_s / 3600.0);
+  std::printf("  wrote %spoints.csv, inputs.csv, truth.json%s in %s\n", written.c_str(), extra.c_str(), a.out.c_str());
+  return 0;
+}
+
+}  // namespace
+
+Subcommand addSimulateCommand(CLI::App& app) {
+  auto a = std::make_shared<SimulateArgs>();
+  auto* simc = app.add_subcommand("simulate", "Run emitted programs, one after the other, on a virtual machine with known error effects");
+  simc->add_option("programs", a->programs, "G-code programs (.ngc LinuxCNC, .nc Fanuc macro B), run back to back")
+      ->required()->check(inputFile());
+  simc->add_option("--machine", a->machine, "machine description (YAML)")->required()->check(inputFile());
+  simc->add_option("--part", a->part, "what stands on the table: a sphere artifact, a thermal test piece or a workpiece (YAML)")->required()->check(inputFile());
+  simc->add_option("--truth", a->truth, "the machine's error effects (YAML, kind: machine_truth)")->required()->check(inputFile());
+  simc->add_option("--out", a->out, "output folder")->capture_default_str();
+  simc->add_option("--seed", a->seed, "random seed")->capture_default_str();
+  simc->add_option("--cmm-points", a->cmm_points, "machined part: CMM points to measure after the programs "
+                   "(feature,point,x_mm,y_mm,z_mm,nx,ny,nz; or a QIF 3.0 plan or a DMIS program: then cmm_results.qif and .dmo too)")->check(inputFile());
+  simc->add_flag("--trace", a->trace, "also write trace.csv: every motion, dwell and tool change with its time and line");
+  simc->add_option("--schedule", a->schedule, "plan manifest (plan.json): start each program at its planned time, the machine "
+                   "off in between (the stepped workpiece's 3 h waits)")->check(inputFile());
+  return {simc, [a] { return runSimulate(*a); }};
+}
+
+}  // namespace probeloop::cli
