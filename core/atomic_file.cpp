@@ -93,18 +93,29 @@ void removeTemporaryFileOnInterrupt() {
   struct sigaction action {};
   action.sa_handler = onInterrupt;
   sigemptyset(&action.sa_mask);
-  for (int sig : {SIGINT, SIGTERM}) {
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
     // A signal the parent ignores (a background job's SIGINT) stays ignored.
     struct sigaction previous {};
     if (::sigaction(sig, nullptr, &previous) == 0 && previous.sa_handler == SIG_IGN) continue;
     ::sigaction(sig, &action, nullptr);
   }
+  // `probeloop plan ... | head -1`: a reader that stops reading must not kill the command
+  // between its summary and the commit of its outputs; the write to stdout fails quietly.
+  ::signal(SIGPIPE, SIG_IGN);
 }
 
 void writeFileAtomic(const std::string& path, const std::string& content) {
   namespace fs = std::filesystem;
   const fs::path target(path);
-  if (target.has_parent_path()) fs::create_directories(target.parent_path());
+  // What the rename would fail on is refused now, before anything is staged or renamed: a
+  // commit then cannot stop half-way over a folder in an output's place.
+  std::error_code ec;
+  const auto status = fs::symlink_status(target, ec);
+  if (!ec && fs::is_directory(status)) throw InputError(path, 0, "cannot write: a folder of that name is in the way");
+  if (target.has_parent_path()) {
+    fs::create_directories(target.parent_path(), ec);
+    if (ec) throw InputError(path, 0, "cannot create its folder: " + ec.message());
+  }
   if (g_batch_open) {
     // The same output written twice in one command: the later content wins, one temporary.
     const std::string k = key(path);

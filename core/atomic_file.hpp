@@ -19,8 +19,9 @@ namespace probeloop {
 
 void writeFileAtomic(const std::string& path, const std::string& content);
 
-// SIGINT / SIGTERM while a file is being written remove its temporary file (with a batch open,
-// every pending one) before the process ends with the signal's usual status (128 + signal).
+// SIGINT / SIGTERM / SIGHUP while a file is being written remove its temporary file (with a
+// batch open, every pending one) before the process ends with the signal's usual status (128 +
+// signal); SIGPIPE is ignored (a closed stdout must not stop a command before its commit).
 // Called once by main(). A SIGKILL cannot be caught: it may leave "<path>.tmp-<pid>" files
 // beside the old ones (never in their place).
 void removeTemporaryFileOnInterrupt();

@@ -15,11 +15,24 @@ inline std::string clipMessage(const std::string& m) {
     while (n > 0 && n < s.size() && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80) --n;
     return n;
   };
+  // A quote opens where no letter or digit stands before it and closes where none follows it,
+  // so the apostrophe of "OPERATOR'S" quotes nothing.
+  auto alnum = [](char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9'); };
+  auto opening = [&](std::size_t from) {
+    for (std::size_t k = m.find('\'', from); k != std::string::npos; k = m.find('\'', k + 1))
+      if (k == 0 || !alnum(m[k - 1])) return k;
+    return std::string::npos;
+  };
+  auto closing = [&](std::size_t from) {
+    for (std::size_t k = m.find('\'', from); k != std::string::npos; k = m.find('\'', k + 1))
+      if (k + 1 >= m.size() || !alnum(m[k + 1])) return k;
+    return std::string::npos;
+  };
   std::string out;
   std::size_t i = 0;
   while (i < m.size()) {
-    const std::size_t open = m.find('\'', i);
-    const std::size_t close = open == std::string::npos ? std::string::npos : m.find('\'', open + 1);
+    const std::size_t open = opening(i);
+    const std::size_t close = open == std::string::npos ? std::string::npos : closing(open + 1);
     if (close == std::string::npos) {
       out.append(m, i, std::string::npos);
       break;

@@ -24,7 +24,7 @@ std::string mib(std::size_t bytes) {
 
 // What is wrong with `path` as an input file, without the path; empty when it is a regular file.
 std::string problemOf(const std::string& path) {
-  if (path.empty()) return "an empty file name";
+  if (path.empty()) return "no file named (an empty file name)";
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {
     const int err = errno;
@@ -36,7 +36,7 @@ std::string problemOf(const std::string& path) {
     if (err == ENOTDIR) return "does not exist (a part of the path is not a folder)";
     return std::string("cannot be read: ") + std::strerror(err);
   }
-  if (S_ISREG(st.st_mode)) return "";
+  if (S_ISREG(st.st_mode)) return ::access(path.c_str(), R_OK) == 0 ? "" : "cannot be read: permission denied";
   if (S_ISDIR(st.st_mode)) return "is a folder, not a file";
   if (S_ISFIFO(st.st_mode))
     return "is a named pipe (FIFO), not a regular file: probeloop reads whole files, not streams";
@@ -105,8 +105,13 @@ std::string decode(const std::string& path, std::string raw, bool binary) {
   if (starts("\xFF\xFE\x00\x00", 4) || starts("\x00\x00\xFE\xFF", 4))
     throw InputError(path, 0, std::string("the file is UTF-32") + (raw[0] == '\xFF' ? "LE" : "BE") +
                                   " (byte-order mark): probeloop reads UTF-8 or UTF-16; save it as UTF-8");
-  if (starts("\xFF\xFE", 2)) return fromUtf16(path, raw, true);
-  if (starts("\xFE\xFF", 2)) return fromUtf16(path, raw, false);
+  if (starts("\xFF\xFE", 2) || starts("\xFE\xFF", 2)) {
+    std::string text = fromUtf16(path, raw, raw[0] == '\xFF');
+    const std::size_t nul = binary ? std::string::npos : text.find('\0');
+    if (nul != std::string::npos)
+      throw InputError(path, 0, "a NUL character at character " + std::to_string(nul) + " of the UTF-16 text: not a text file");
+    return text;
+  }
   if (starts("\xEF\xBB\xBF", 3)) raw.erase(0, 3);
   const std::size_t nul = binary ? std::string::npos : raw.find('\0');
   if (nul != std::string::npos) {
@@ -196,7 +201,7 @@ std::string describeContent(const std::string& text) {
     q = e + 1;
     while (!l.empty() && (l.back() == '\r' || l.back() == ' ' || l.back() == '\t')) l.pop_back();
     if (l.empty() || l[0] == '#' || l == "%") continue;  // '%': a Fanuc tape mark (programs and DPRNT captures)
-    first = l;
+    first = l.substr(0, 200);  // the regexes below recurse per character
     break;
   }
   for (const char* d : {"DMISMN", "FILNAM", "DMISMD", "DMISMN/", "FILNAM/"})

@@ -143,9 +143,14 @@ TEST(ClipMessage, LongTokensAndMessagesAreCut) {
   // A cut never splits a UTF-8 character: 2-byte 'µ' repeated across the cut.
   std::string mu;
   for (int i = 0; i < 200; ++i) mu += "\xC2\xB5";
-  const std::string clipped = clipMessage("'" + mu + "'");
-  EXPECT_EQ(clipped.substr(0, 61), "'" + mu.substr(0, 60));
+  // One ASCII byte first: byte 60 of the token is then a continuation byte, and the cut must
+  // step back to 59.
+  const std::string clipped = clipMessage("'x" + mu + "'");
+  EXPECT_EQ(clipped.substr(0, 61), "'x" + mu.substr(0, 58) + ".");
   EXPECT_EQ(SafetyError("a '" + token + "'").what(), clipMessage("a '" + token + "'"));
+  // Apostrophes inside words quote nothing: an alarm text of 150 characters stays whole.
+  const std::string alarm = "program alarm #3000=1 (OPERATOR'S NOTE: " + std::string(150, 'n') + " CHECK THE STYLUS'S TIP)";
+  EXPECT_EQ(clipMessage(alarm), alarm);
 }
 
 TEST_F(InputFile, ABatchCommitsAllOutputsOrNone) {
@@ -178,11 +183,19 @@ TEST_F(InputFile, ABatchCommitsAllOutputsOrNone) {
   std::size_t files = 0;
   for (const auto& e : fs::directory_iterator(path("out"))) files += e.is_regular_file();
   EXPECT_EQ(files, 2u);  // no temporary left behind
-  // A write that fails inside a batch leaves the others' old versions too.
-  {
+  // A write that fails inside a batch leaves the others' old versions too: a folder that cannot
+  // be created, and a folder standing where an output goes (refused when staged, so that the
+  // commit cannot stop half-way at its rename).
+  fs::create_directories(path("out/scene.gltf"));
+  for (const std::string& bad : {std::string("/proc/probeloop_cannot_write_here/x.gltf"), path("out/scene.gltf")}) {
     OutputBatch batch;
     writeFileAtomic(a, "third a");
-    EXPECT_THROW(writeFileAtomic("/proc/probeloop_cannot_write_here/x.gltf", "scene"), std::exception);
+    try {
+      writeFileAtomic(bad, "scene");
+      ADD_FAILURE() << "not refused: " << bad;
+    } catch (const InputError& e) {
+      expectHas(e.what(), bad + ": cannot");
+    }
   }
   EXPECT_EQ(readFile(a), "newer a");
   EXPECT_THROW({ OutputBatch one; OutputBatch two; }, std::logic_error);

@@ -118,18 +118,22 @@ EvaluationFiles steppedWorkpiece(const parts::PlanManifest& m, const EvaluateReq
 namespace {
 
 EvaluationFiles evaluateByKind(const parts::PlanManifest& m, const EvaluateRequest& r) {
-  if (m.kind == "sphere_artifact") {
+  const parts::PieceKind kind = m.pieceKind();
+  if (kind == parts::PieceKind::SphereArtifact) {
     if (!r.compare_with.empty())
       throw InputError("", 0, "--compare applies to the thermal test piece (seed 004 Table 7.2), not to a sphere-artifact campaign");
     return sphere(m, r);
   }
   if (!r.cycle_starts.empty())
     throw InputError(r.cycle_starts, 0, "--cycle-starts applies to a sphere-artifact campaign's cycles, not to a " + m.kind);
-  if (!r.probe_log.empty() && m.kind != "stepped_workpiece")
+  if (!r.probe_log.empty() && kind != parts::PieceKind::SteppedWorkpiece)
     throw InputError("", 0, "--probe-log applies to the stepped workpiece (its CMM export and probe log together)");
-  if (m.kind == "thermal_test_piece") return thermalTestPiece(m, r);
-  if (m.kind == "stepped_workpiece") return steppedWorkpiece(m, r);
-  throw InputError(m.file, 0, "manifest kind '" + m.kind + "': evaluate knows sphere_artifact, thermal_test_piece and stepped_workpiece");
+  switch (kind) {
+    case parts::PieceKind::ThermalTestPiece: return thermalTestPiece(m, r);
+    case parts::PieceKind::SteppedWorkpiece: return steppedWorkpiece(m, r);
+    case parts::PieceKind::SphereArtifact: return sphere(m, r);  // (returned above)
+  }
+  throw std::logic_error("evaluateByKind: a PieceKind without an evaluation");
 }
 
 }  // namespace
@@ -192,9 +196,9 @@ std::string spherePredictionText(const parts::PlanManifest& m) {
 }
 
 std::string planPrediction(const parts::PlanManifest& m, double step_mm) {
-  if (m.kind == "sphere_artifact")
+  if (m.pieceKind() == parts::PieceKind::SphereArtifact)
     return sphereResolutionText(locationErrorResolution(m, step_mm), step_mm * 1e3) + spherePredictionText(m);
-  if (m.kind != "thermal_test_piece") return "";
+  if (m.pieceKind() != parts::PieceKind::ThermalTestPiece) return "";
   std::string o;
   const auto p = predictThermalTestPiece(m);
   if (!p.note.empty()) {

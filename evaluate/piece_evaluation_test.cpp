@@ -26,7 +26,7 @@ TEST(TestPieceDispatch, UnknownKindsAndMisplacedOptionsAreRefused) {
   m.kind = "gear";
   EvaluateRequest r;
   r.input_file = "points.csv";
-  EXPECT_NE(refusal(m, r).find("plan.json: manifest kind 'gear': evaluate knows sphere_artifact, thermal_test_piece and stepped_workpiece"),
+  EXPECT_NE(refusal(m, r).find("plan.json: manifest kind 'gear': plans are made for sphere_artifact, thermal_test_piece and stepped_workpiece"),
             std::string::npos);
   m.kind = "stepped_workpiece";
   EXPECT_NE(refusal(m, r).find("points.csv: the stepped workpiece is evaluated from its CMM export and its on-machine probe log together"),

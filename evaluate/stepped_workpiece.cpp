@@ -226,7 +226,7 @@ SwRepeatability probeRepeatability(const parts::PlanManifest& m, const TtpPoints
 }
 
 SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoints& cmm, const TtpPoints& probe) {
-  if (m.kind != "stepped_workpiece")
+  if (parts::parsePieceKind(m.kind) != parts::PieceKind::SteppedWorkpiece)
     throw InputError(m.file, 0, "kind: '" + m.kind + "': the stepped-workpiece evaluation needs a stepped_workpiece plan");
   SwEvaluation e;
   e.experiment = m.sw.experiment;
@@ -414,7 +414,7 @@ void compareWithBefore(SwEvaluation& e, const parts::PlanManifest& m, const std:
     throw InputError(m.file, 0, "--compare: this plan was not compensated (plan --compensate); nothing was promised to compare with");
   nlohmann::json b;
   try {
-    b = nlohmann::json::parse(readFile(file));
+    b = nlohmann::json::parse(readFile(file, kJsonInput));
   } catch (const nlohmann::json::exception& x) {
     throw InputError(file, 0, std::string("not JSON: ") + x.what());
   }

@@ -32,9 +32,10 @@ class FuzzMachine : public gcode::MachineInterface {
     out.contact = (probes_++ % 2) == 0;
     out.stop = to;
     if (out.contact) {
-      out.stop.xyz_mm = 0.5 * (at_.xyz_mm + to.xyz_mm);
-      out.stop.b_deg = 0.5 * (at_.b_deg + to.b_deg);
-      out.stop.c_deg = 0.5 * (at_.c_deg + to.c_deg);
+      // 0.5 a + 0.5 b: finite for any finite a and b (a + b may overflow).
+      out.stop.xyz_mm = 0.5 * at_.xyz_mm + 0.5 * to.xyz_mm;
+      out.stop.b_deg = 0.5 * at_.b_deg + 0.5 * to.b_deg;
+      out.stop.c_deg = 0.5 * at_.c_deg + 0.5 * to.c_deg;
     }
     move(out.stop, feed_mm_per_min);
     return out;

@@ -1076,6 +1076,7 @@ class Execution {
     Eigen::Vector2d centre;
     if (w.has('R')) {
       const double r = w.take('R'), d = (b - a).norm();
+      if (std::fabs(r) > 1e5) fail("arc radius R" + formatG(r) + " mm is not plausible");
       if (d < 1e-9 || std::fabs(r) < d / 2 - 1e-9) fail("arc radius R is too small for the end point");
       const double h = std::sqrt(std::max(0.0, r * r - d * d / 4));
       const Eigen::Vector2d mid = (a + b) / 2, perp = Eigen::Vector2d(-(b - a).y(), (b - a).x()) / d;

@@ -102,7 +102,8 @@ class Interpreter {
   // Runs from the first line to M2/M30 (or the end of the text).
   InterpreterResult run(MachineInterface& machine, long max_blocks = kMaxBlocks, ProbeBranching* branching = nullptr);
 
-  // Parameters after (or during) a run, for tests: numbered and named (lower case).
+  // Parameters after a run (published when it ends or stops), for tests: numbered and named
+  // (lower case).
   double parameter(int number) const;
   double namedParameter(const std::string& name) const;
 

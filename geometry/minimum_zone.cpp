@@ -55,8 +55,7 @@
 //   line2d mz: convex hull (exact orientation predicate) + rotating calipers.
 // Own SLP from a start: plane mz from PCA (the orthogonal least-squares plane; CGAL
 // Width_3 is exact but takes 0.7 s at 1e4 points, so it serves as the test reference);
-// line3d mz from the PCA line; cylinder mz/mi/mc from fitLeastSquares (or an own
-// Gauss-Newton cylinder while that is unavailable).
+// line3d mz from the PCA line; cylinder mz/mi/mc from fitLeastSquares.
 //
 // Tolerances (S = largest distance of a point from the centroid, mm):
 // - convergence: the SLP stops when the linearised LP predicts an improvement below
@@ -916,76 +915,15 @@ Vector2d minWidthDirection(const Points3& q) {
 
 // ------------------------------------------------------------------ starts
 
-// Own least-squares cylinder, used while fitLeastSquares is unavailable: of the three
-// principal axes the one whose projection is most circular (algebraic Kasa circle), then
-// Gauss-Newton on the orthogonal distances (axis model plus the radius; normal equations
-// are enough for a start).
-AxisModel ownCylinderStart(const Frame& f) {
-  const auto eig = scatter(f.q);
-  const int n = static_cast<int>(f.q.size());
-  double best_rms = std::numeric_limits<double>::infinity();
-  AxisModel m(&f.q, Vector3d::Zero(), eig.eigenvectors().col(2), f.size);
-  VectorXd r(n);
-  for (int k = 0; k < 3; ++k) {
-    const Vector3d a = eig.eigenvectors().col(k);
-    const Vector3d e1 = anyPerpendicular(a);
-    const Vector3d e2 = a.cross(e1);
-    // x^2 + y^2 = 2 cx x + 2 cy y + c0 in the plane perpendicular to a.
-    Eigen::Matrix3d AtA = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d Atb = Eigen::Vector3d::Zero();
-    for (int i = 0; i < n; ++i) {
-      const double x = e1.dot(f.q[i]), y = e2.dot(f.q[i]);
-      const Eigen::Vector3d row(2.0 * x, 2.0 * y, 1.0);
-      AtA += row * row.transpose();
-      Atb += row * (x * x + y * y);
-    }
-    const Eigen::Vector3d s = AtA.ldlt().solve(Atb);
-    if (!s.allFinite()) continue;
-    const AxisModel t(&f.q, s[0] * e1 + s[1] * e2, a, f.size);
-    evaluateAll(t, r, nullptr);
-    const double rms = std::sqrt((r.array() - r.mean()).square().sum() / n);
-    if (rms < best_rms) {
-      best_rms = rms;
-      m = t;
-    }
-  }
-  RowMatrix J(n, 4);
-  for (int it = 0; it < 30; ++it) {  // Gauss-Newton with the radius as 5th unknown
-    evaluateAll(m, r, &J);
-    const double rad = r.mean();
-    Eigen::Matrix<double, 5, 5> N = Eigen::Matrix<double, 5, 5>::Zero();
-    Eigen::Matrix<double, 5, 1> g = Eigen::Matrix<double, 5, 1>::Zero();
-    for (int i = 0; i < n; ++i) {
-      Eigen::Matrix<double, 5, 1> row;
-      row << J(i, 0), J(i, 1), J(i, 2), J(i, 3), -1.0;
-      N += row * row.transpose();
-      g -= row * (r[i] - rad);
-    }
-    const Eigen::Matrix<double, 5, 1> d = N.ldlt().solve(g);
-    if (!d.allFinite()) break;
-    const AxisModel t = m.stepped(d.head<4>());
-    VectorXd rt(n);
-    evaluateAll(t, rt, nullptr);
-    const double rms = std::sqrt((r.array() - rad).square().sum() / n);
-    const double rms_t = std::sqrt((rt.array() - rt.mean()).square().sum() / n);
-    if (!(rms_t < rms)) break;
-    m = t;
-    if (d.head<4>().norm() < 1e-12 * f.size) break;
-  }
-  return m;
-}
-
+// The least-squares cylinder (the one LS engine, least_squares.hpp): points it cannot fit a
+// cylinder to (too few, collinear, coplanar on a line...) have no minimum-zone cylinder either,
+// and its GeometryError says why.
 AxisModel cylinderStart(const Frame& f, const Points3& points) {
-  try {
-    const FitResult ls = fitLeastSquares(ElementKind::Cylinder, points);
-    const Element& e = ls.element;
-    if (e.kind == ElementKind::Cylinder && e.position_mm.allFinite() && e.direction.allFinite() &&
-        e.direction.norm() > 0.5)
-      return AxisModel(&f.q, e.position_mm - f.origin, e.direction, f.size);
-  } catch (const GeometryError&) {
-    // Not available or not applicable here: the own start below is as good a start.
-  }
-  return ownCylinderStart(f);
+  const FitResult ls = fitLeastSquares(ElementKind::Cylinder, points);
+  const Element& e = ls.element;
+  if (e.kind != ElementKind::Cylinder || !e.position_mm.allFinite() || !e.direction.allFinite() || !(e.direction.norm() > 0.5))
+    throw GeometryError("the least-squares cylinder that starts the minimum-zone fit has no finite axis");
+  return AxisModel(&f.q, e.position_mm - f.origin, e.direction, f.size);
 }
 
 // ------------------------------------------------------------------ results

@@ -103,7 +103,7 @@ TEST(Machine, YamlSyntaxErrorHasLine) {
 TEST(SphereArtifact, AKeyWrittenTwiceIsRefusedWithBothLines) {
   const auto m = artifactError("  diameter: 30 mm", "  diameter: 30 mm\n  diameter: 3000 mm");
   EXPECT_NE(m.find("artifact.yaml:6: key 'diameter' is written twice (lines 5 and 6)"), std::string::npos) << m;
-  // At the top level, and in a list of mappings too.
+  // At the top level too.
   const auto top = artifactError("kind: sphere_artifact", "kind: sphere_artifact\nkind: sphere_artifact");
   EXPECT_NE(top.find("key 'kind' is written twice (lines 3 and 4)"), std::string::npos) << top;
 }

@@ -113,8 +113,8 @@ std::string caret(const std::string& file_text, int line, int file_column, const
 }  // namespace
 
 uncertainty::TextModel loadGumModel(const std::string& path) {
-  const std::string text = readFile(path, kYamlInput);
-  YamlMap root(loadYamlFile(path), path, "");
+  const std::string text = readFile(path, kYamlInput);  // read once: the carets quote its lines
+  YamlMap root(loadYamlText(text, path), path, "");
   root.choice("kind", {"gum_model"});
   uncertainty::TextModel m;
   m.file = path;

@@ -386,12 +386,25 @@ void readGeneric(const ordered_json& j, PlanManifest& m) {
 
 }  // namespace
 
+std::optional<PieceKind> parsePieceKind(const std::string& name) {
+  if (name == "sphere_artifact") return PieceKind::SphereArtifact;
+  if (name == "thermal_test_piece") return PieceKind::ThermalTestPiece;
+  if (name == "stepped_workpiece") return PieceKind::SteppedWorkpiece;
+  return std::nullopt;
+}
+
+PieceKind PlanManifest::pieceKind() const {
+  if (const auto k = parsePieceKind(kind)) return *k;
+  throw InputError(file, 0, "manifest kind '" + kind + "': plans are made for sphere_artifact, thermal_test_piece and stepped_workpiece");
+}
+
 PlanManifest readManifest(const std::string& path) {
   ordered_json j;
+  const std::string text = readFile(path, kJsonInput);
   try {
-    j = ordered_json::parse(readFile(path, kJsonInput));
+    j = ordered_json::parse(text);
   } catch (const ordered_json::parse_error& e) {
-    const std::string kind = describeContent(readFile(path, kJsonInput));
+    const std::string kind = describeContent(text);
     throw InputError(path, 0, "not a plan manifest: " + (kind.empty() ? std::string("not valid JSON (") + e.what() + ")"
                                                                       : "the file looks like " + kind +
                                                                             "; the manifest is the plan.json that `probeloop plan` writes"));

@@ -4,6 +4,7 @@
 #pragma once
 #include <Eigen/Dense>
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -102,9 +103,16 @@ struct SteppedWorkpieceConstants {
   std::string cmm_plan;
 };
 
+// The kinds of test piece a plan is made for. The manifest keeps the kind's name (`kind`, the
+// JSON field); every dispatcher switches on the type (PlanManifest::pieceKind()).
+enum class PieceKind { SphereArtifact, ThermalTestPiece, SteppedWorkpiece };
+std::optional<PieceKind> parsePieceKind(const std::string& name);  // nullopt: not a kind with a plan
+
 struct PlanManifest {
   std::string file;
   std::string kind = "sphere_artifact";
+  // The kind as a type; InputError naming the file for a kind no planner writes.
+  PieceKind pieceKind() const;
   std::string dialect;
   std::vector<ManifestProgram> programs;
   // Machine.

@@ -32,7 +32,7 @@ SwCompensation loadSwCompensation(const std::string& path) {
   c.file = path;
   nlohmann::json j;
   try {
-    j = nlohmann::json::parse(readFile(path));
+    j = nlohmann::json::parse(readFile(path, kJsonInput));
   } catch (const nlohmann::json::exception& e) {
     throw InputError(path, 0, std::string("not JSON: ") + e.what());
   }

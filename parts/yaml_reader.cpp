@@ -56,8 +56,9 @@ class KeyCheck {
 
 }  // namespace
 
-YAML::Node loadYamlFile(const std::string& path) {
-  const std::string text = readFile(path, kYamlInput);
+YAML::Node loadYamlFile(const std::string& path) { return loadYamlText(readFile(path, kYamlInput), path); }
+
+YAML::Node loadYamlText(const std::string& text, const std::string& path) {
   YAML::Node doc;
   try {
     doc = YAML::Load(text);

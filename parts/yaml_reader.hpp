@@ -13,7 +13,9 @@
 
 namespace probeloop::parts {
 
-YAML::Node loadYamlFile(const std::string& path);  // syntax errors -> InputError with line
+// Syntax errors, keys written twice, keys that are not plain names -> InputError with line.
+YAML::Node loadYamlFile(const std::string& path);
+YAML::Node loadYamlText(const std::string& text, const std::string& path);  // the same, text already read
 
 class YamlMap {
  public:

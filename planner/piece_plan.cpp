@@ -247,7 +247,7 @@ TestPiecePlan planTestPiece(const parts::TestPiece& piece, const parts::Machine&
                                         piece.kind + ")");
   if (const auto* a = piece.sphereArtifact()) return sphere(*a, machine, dialect, out_dir);
   if (const auto* t = piece.thermalTestPiece()) return thermal(piece, *t, machine, dialect, out_dir);
-  if (piece.kind == "workpiece")
+  if (std::holds_alternative<parts::Workpiece>(piece.description))
     throw InputError(piece.file, 0,
                      "a plain workpiece has no planner: write its program yourself and run it with probeloop simulate");
   throw InputError(piece.file, 0, "kind: '" + piece.kind + "' has no planner");

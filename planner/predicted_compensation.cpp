@@ -24,7 +24,7 @@ nlohmann::json readJson(const std::string& path) {
 // The compensation the evaluation predicts for the experiment as first planned (micrometres).
 parts::SwCompensation predictedCompensation(const TestPiecePlan& first, const std::string& evaluation_file) {
   const auto& m = first.manifest;
-  if (m.kind != "stepped_workpiece")
+  if (parts::parsePieceKind(m.kind) != parts::PieceKind::SteppedWorkpiece)
     throw InputError(evaluation_file, 0, "--predict-from: only a stepped workpiece's finishing takes a predicted compensation");
   const nlohmann::json j = readJson(evaluation_file);
   model::SteppedPredictor predictor;

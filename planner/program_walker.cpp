@@ -21,19 +21,6 @@ double round3(double v) {
   return r == 0 ? 0.0 : r;
 }
 
-double rotaryIndexSeconds(double delta_deg, const parts::RotaryAxis& ax) {
-  if (delta_deg == 0) return 0;
-  return std::fabs(delta_deg) / (ax.max_speed_rpm * 360.0) * 60.0;
-}
-
-double rapidSeconds(const parts::Machine& m, const Vector3d& d, double db, double dc) {
-  return std::max({d.cwiseAbs().maxCoeff() / m.rapid_feed_mm_per_min * 60.0, rotaryIndexSeconds(dc, m.c),
-                   m.b.present ? rotaryIndexSeconds(db, m.b) : 0.0});
-}
-
-double linearFeedSeconds(double path_mm, double F) { return path_mm / F * 60.0; }
-double rotaryFeedSeconds(double delta_deg, double F) { return std::fabs(delta_deg) / F * 60.0; }
-
 NotedProgram newNotedProgram(const parts::Machine& m, const std::string& role, const std::string& file, int number,
                              const std::string& title) {
   NotedProgram p;

@@ -30,6 +30,7 @@
 
 #include "gcode/program.hpp"
 #include "parts/machine.hpp"
+#include "parts/machine_clock.hpp"
 
 namespace probeloop::planner {
 
@@ -127,15 +128,11 @@ class ProgramWalker {
   WalkTimes times_;
 };
 
-// The simulator's clock (docs/simulator.md §2), in seconds.
-// A rapid: every axis at once, linear ones at the rapid feed, B and C at their max_speed.
-double rapidSeconds(const parts::Machine& m, const Eigen::Vector3d& gauge_delta_mm, double b_delta_deg = 0,
-                    double c_delta_deg = 0);
-// A rotary axis indexing by `delta_deg` at its positioning speed (max_speed).
-double rotaryIndexSeconds(double delta_deg, const parts::RotaryAxis& axis);
-// A feed move: XYZ path length / F; a move of C alone: degrees / F (F in deg/min).
-double linearFeedSeconds(double path_mm, double feed_mm_per_min);
-double rotaryFeedSeconds(double delta_deg, double feed_deg_per_min);
+// The clock is the machine's (parts/machine_clock.hpp), shared with the simulator.
+using parts::linearFeedSeconds;
+using parts::rapidSeconds;
+using parts::rotaryFeedSeconds;
+using parts::rotaryIndexSeconds;
 
 // The value a writer prints (coordinates 4 decimals, C / feeds / dwells 3): planners build
 // their ops from these so that what they time is what the controller reads.

@@ -8,6 +8,7 @@
 #include "core/csv.hpp"
 #include "core/error.hpp"
 #include "core/units.hpp"
+#include "parts/machine_clock.hpp"
 #include "planner/angles.hpp"
 
 namespace probeloop::planner {
@@ -26,8 +27,8 @@ bool sameAngle(double a, double b) {
 // Walks the ops like a machine would, to time them and to check every target against the
 // travel of the gauge line. Not planner/program_walker.hpp on purpose: this walker starts at
 // the tool-change height above an unknown XY and times each cycle alone, the shared walker
-// starts where the simulator does and runs the whole session; porting the sphere cycle to it
-// would change its planned times and so the bytes of its plan.json and program header.
+// starts where the simulator does and runs the whole session. Its clock is the machine's
+// (parts/machine_clock.hpp), the one the simulator and program_walker use (issue 29).
 class Walker {
  public:
   Walker(const Machine& m, CycleTime& t) : m_(m), t_(&t) {
@@ -61,7 +62,7 @@ class Walker {
   }
   void rapidTo(const Vector3d& g, const std::string& where, const std::string& what) {
     check(g, where, what);
-    t_->rapid_s += (g - gauge_).cwiseAbs().maxCoeff() / (m_.rapid_feed_mm_per_min / 60.0);
+    t_->rapid_s += parts::rapidSeconds(m_, g - gauge_);
     gauge_ = g;
   }
   void step(const gcode::Comment&, const std::string&) {}
@@ -78,7 +79,7 @@ class Walker {
   void step(const gcode::RotateC& r, const std::string& where) {
     if (!m_.c.continuous && (r.c_deg < m_.c.min_deg || r.c_deg > m_.c.max_deg))
       throw SafetyError(where + ": C = " + formatNumber(r.c_deg, 3) + " deg is outside the C travel");
-    t_->c_index_s += std::fabs(r.c_deg - c_) / (m_.c.max_speed_rpm * 6.0);
+    t_->c_index_s += parts::rotaryIndexSeconds(r.c_deg - c_, m_.c);
     c_ = r.c_deg;
   }
   void step(const gcode::ToolChange& tc, const std::string&) {
@@ -88,14 +89,14 @@ class Walker {
   void step(const gcode::ProtectedMove& p, const std::string& where) {
     const Vector3d g(p.x, p.y, p.z + length_);
     check(g, where, "protected move");
-    t_->protected_s += (g - gauge_).norm() / (p.feed_mm_per_min / 60.0);
+    t_->protected_s += parts::linearFeedSeconds((g - gauge_).norm(), p.feed_mm_per_min);
     gauge_ = g;
   }
   void step(const gcode::ProbeMove& p, const std::string& where) {
     // Timed to the nominal contact (set by the planner); the end is checked for travel.
     const Vector3d g(p.x, p.y, p.z + length_);
     check(g, where, "probing move end (overtravel)");
-    t_->probing_s += (contact_ + Vector3d(0, 0, length_) - gauge_).norm() / (p.feed_mm_per_min / 60.0);
+    t_->probing_s += parts::linearFeedSeconds((contact_ + Vector3d(0, 0, length_) - gauge_).norm(), p.feed_mm_per_min);
     gauge_ = contact_ + Vector3d(0, 0, length_);
   }
   void step(const gcode::Dwell&, const std::string&) {}  // no dwell inside a cycle

@@ -49,6 +49,7 @@ dict_of() {
     xyz|nist_ds) echo points;;
     fit_csv|points_csv|inputs_errors_csv|ttp_cmm_csv) echo csv;;
     probe_log|ttp_on_machine) echo probe_log;;
+    verify_linuxcnc) echo gcode_linuxcnc;;
     *_yaml) echo yaml;;
     *_json) echo json;;
     *) echo "$1";;  # gum_expression, gcode_linuxcnc, gcode_fanuc, qif, dmis

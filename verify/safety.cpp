@@ -302,7 +302,8 @@ class Checker : public gcode::MachineInterface, public gcode::ProbeBranching {
     } else {
       other.contact = true;
       other.stop = probe_from_;
-      other.stop.xyz_mm = probe_from_.xyz_mm + 0.5 * (probe_to_.xyz_mm - probe_from_.xyz_mm);
+      // Half-way; 0.5 a + 0.5 b stays finite where b - a would overflow.
+      other.stop.xyz_mm = 0.5 * probe_from_.xyz_mm + 0.5 * probe_to_.xyz_mm;
     }
     const State saved = state();
     Unprotected u{line_, probes_ - 1, nominal.contact, "", tip(nominal.stop)};

@@ -7,6 +7,8 @@
 
 #include <cstdlib>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "core/error.hpp"
 #include "gcode/program.hpp"
@@ -236,6 +238,79 @@ TEST(SafetyVerifier, UnknownToolIsBadInput) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("t.ngc:2"), std::string::npos) << e.what();
   }
+}
+
+}  // namespace
+}  // namespace probeloop::verify
+
+namespace probeloop::verify {
+namespace {
+
+// The emitted probing sequence with the #5070 check after its G38.3 replaced by `insert`.
+std::string withoutContactCheck(const std::string& ok, const std::vector<std::string>& insert, int& g38_line) {
+  std::vector<std::string> lines;
+  std::istringstream in(ok);
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  std::size_t i = 0;
+  while (lines[i].rfind("G38.3", 0) != 0) ++i;
+  g38_line = static_cast<int>(i) + 1;
+  lines.erase(lines.begin() + static_cast<long>(i) + 1, lines.begin() + static_cast<long>(i) + 4);  // o1 if / ABORT / endif
+  lines.insert(lines.begin() + static_cast<long>(i) + 1, insert.begin(), insert.end());
+  std::string t;
+  for (const auto& l : lines) t += l + "\n";
+  return t;
+}
+
+// Issue 29: each probe move's inverted outcome runs on a copy of the interpreter's state at the
+// move (parameters included), not on the nominal run's. Here the branch adds 1 to #100 before
+// its next move; were the parameters shared, the nominal run would then see #100 = 2 and stop
+// (a program-stops finding). Only the unprotected G38.3 is found.
+TEST(SafetyVerifier, AProbeBranchRunsOnACopyOfTheState) {
+  SphereSetup s;
+  int g38 = 0;
+  const std::string t = withoutContactCheck(gcode::writeLinuxCnc(s.program(s.probing())),
+                                            {"#100 = [#100 + 1]", "G0 X-139 Y0 Z75", "o2 if [#100 GT 1]",
+                                             "(ABORT, the branch's parameter reached the nominal run)", "o2 endif"},
+                                            g38);
+  const auto r = s.check(t);
+  ASSERT_EQ(r.findings.size(), 1u) << listed(r);
+  EXPECT_TRUE(has(r, "probe-unprotected", g38)) << listed(r);
+  EXPECT_NE(r.findings[0].what.find("goes on to a rapid move"), std::string::npos) << listed(r);
+}
+
+// A probe line that also ends the program (M2 on it): the branch ends there too, and the
+// finding says the program went on to its end.
+TEST(SafetyVerifier, AProbeLineThatEndsTheProgramGoesOnToItsEnd) {
+  SphereSetup s;
+  int g38 = 0;
+  std::string t = withoutContactCheck(gcode::writeLinuxCnc(s.program(s.probing())), {}, g38);
+  const std::size_t at = t.find("G38.3");
+  t.insert(t.find('\n', at), " M2");
+  const auto r = s.check(t);
+  ASSERT_EQ(r.findings.size(), 1u) << listed(r);
+  EXPECT_TRUE(has(r, "probe-unprotected", g38)) << listed(r);
+  EXPECT_NE(r.findings[0].what.find("goes on to the program's end"), std::string::npos) << listed(r);
+}
+
+// A probe line inside a loop is tried once (its first execution), and the loop's other
+// iterations do not repeat the finding.
+TEST(SafetyVerifier, AProbeLineInALoopIsTriedOnce) {
+  SphereSetup s;
+  int g38 = 0;
+  std::string t = withoutContactCheck(gcode::writeLinuxCnc(s.program(s.probing())), {}, g38);
+  // The descent in a loop of three, each turn from the clearance plane (a retreat), so that the
+  // last one leaves the probe where the measuring move expects it.
+  std::vector<std::string> lines;
+  std::istringstream in(t);
+  for (std::string l; std::getline(in, l);) lines.push_back(l);
+  const auto i = static_cast<long>(g38) - 1;
+  lines.insert(lines.begin() + i + 1, {"#101 = [#101 + 1]", "o3 endwhile"});
+  lines.insert(lines.begin() + i, {"#101 = 0", "o3 while [#101 LT 3]", "G0 Z113"});
+  t.clear();
+  for (const auto& l : lines) t += l + "\n";
+  const auto r = s.check(t);
+  ASSERT_EQ(r.findings.size(), 1u) << listed(r);
+  EXPECT_TRUE(has(r, "probe-unprotected", g38 + 3)) << listed(r);
 }
 
 }  // namespace
