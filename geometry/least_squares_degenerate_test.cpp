@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "geometry/least_squares.hpp"
+#include "geometry/reference_sphere_fit_test_support.hpp"
 #include "geometry/sphere_fit.hpp"
 
 using namespace probeloop;
@@ -97,8 +98,9 @@ TEST(LeastSquaresDegenerate, ConeOfACylinderSuggestsACylinder) {
 }
 
 TEST(LeastSquaresSphere, AgreesWithTheSphereArtifactFit) {
-  // The sphere-artifact evaluation's fitSphere and the suite's sphere are two
-  // implementations of the same estimator; they must agree on noisy probe data.
+  // The LS engine against a second, independent implementation of the same estimator
+  // (reference_sphere_fit_test_support.hpp, the sphere-artifact evaluation's fit before
+  // issue 29); they must agree on noisy probe data, and fitSphere (now the engine) with it.
   Points3 p;
   for (int i = 0; i < 9; ++i) {
     const double th = 0.3 + 1.2 * i / 8.0, ph = 2.4 * i;
@@ -106,8 +108,11 @@ TEST(LeastSquaresSphere, AgreesWithTheSphereArtifactFit) {
     p.push_back(Vector3d(-160, 3, 75) + r * Vector3d(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)));
   }
   const FitResult a = fitLeastSquares(ElementKind::Sphere, p);
-  const SphereFit b = fitSphere(p);
+  const SphereFit b = referenceSphereFit(p);
   EXPECT_LT((a.element.position_mm - b.centre_mm).norm(), 1e-10);
   EXPECT_NEAR(a.element.radius_mm, b.radius_mm, 1e-10);
+  const SphereFit c = fitSphere(p);
+  EXPECT_EQ(c.centre_mm, a.element.position_mm);
+  EXPECT_EQ(c.radius_mm, a.element.radius_mm);
   EXPECT_TRUE(std::isfinite(a.rms_mm));
 }
