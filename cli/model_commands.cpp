@@ -12,7 +12,7 @@
 #include "core/atomic_file.hpp"
 #include "core/csv.hpp"
 #include "core/error.hpp"
-#include "cli/json_file.hpp"
+#include "parts/json_file.hpp"
 #include "model/diagnose.hpp"
 #include "model/stepped_series.hpp"
 #include "model/outputs.hpp"
@@ -22,6 +22,7 @@
 #include "report/model_report.hpp"
 
 namespace probeloop::cli {
+using parts::readJsonFile;
 namespace fs = std::filesystem;
 
 namespace {

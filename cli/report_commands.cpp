@@ -6,7 +6,7 @@
 #include <string>
 
 #include "cli/input_option.hpp"
-#include "cli/json_file.hpp"
+#include "parts/json_file.hpp"
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "parts/plan_manifest.hpp"
@@ -15,6 +15,7 @@
 #include "report/ttp_scene.hpp"
 
 namespace probeloop::cli {
+using parts::readJsonFile;
 namespace {
 
 struct TtpArgs {

@@ -8,12 +8,13 @@
 #include <vector>
 
 #include "cli/input_option.hpp"
-#include "cli/json_file.hpp"
+#include "parts/json_file.hpp"
 #include "core/atomic_file.hpp"
 #include "model/control_errors.hpp"
 #include "model/thermal_stages.hpp"
 
 namespace probeloop::cli {
+using parts::readJsonFile;
 namespace {
 
 struct SeparateArgs {

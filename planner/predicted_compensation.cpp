@@ -3,30 +3,19 @@
 #include <nlohmann/json.hpp>
 
 #include "core/error.hpp"
-#include "core/input_file.hpp"
+#include "parts/json_file.hpp"
 #include "model/stepped_prediction.hpp"
 #include "model/thermal_stages.hpp"
 
 namespace probeloop::planner {
 namespace {
 
-nlohmann::json readJson(const std::string& path) {
-  const std::string text = readFile(path, kJsonInput);
-  try {
-    return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
-    const std::string kind = describeContent(text);
-    throw InputError(path, 0, std::string("not valid JSON (") + e.what() + ")" +
-                                  (kind.empty() || kind.find("JSON") != std::string::npos ? "" : "; the file looks like " + kind));
-  }
-}
-
 // The compensation the evaluation predicts for the experiment as first planned (micrometres).
 parts::SwCompensation predictedCompensation(const TestPiecePlan& first, const std::string& evaluation_file) {
   const auto& m = first.manifest;
   if (parts::parsePieceKind(m.kind) != parts::PieceKind::SteppedWorkpiece)
     throw InputError(evaluation_file, 0, "--predict-from: only a stepped workpiece's finishing takes a predicted compensation");
-  const nlohmann::json j = readJson(evaluation_file);
+  const nlohmann::json j = parts::readJsonFile(evaluation_file);
   model::SteppedPredictor predictor;
   if (j.is_object() && j.value("kind", "") == "stepped_separation") {
     const auto c = model::campaignFromSeparationJson(j, evaluation_file);

@@ -1,12 +1,13 @@
-// A JSON file read whole; InputError naming the file when it is not JSON.
+// A JSON input (an evaluation.json, a separation.json) read whole: InputError naming the file
+// when it is not JSON, with what the file looks like instead (core/input_file.hpp).
 #pragma once
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "core/atomic_file.hpp"
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 
-namespace probeloop::cli {
+namespace probeloop::parts {
 
 inline nlohmann::json readJsonFile(const std::string& path) {
   const std::string text = readFile(path, kJsonInput);
@@ -19,4 +20,4 @@ inline nlohmann::json readJsonFile(const std::string& path) {
   }
 }
 
-}  // namespace probeloop::cli
+}  // namespace probeloop::parts
