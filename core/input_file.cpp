@@ -4,10 +4,10 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstdint>
 #include <cstring>
-#include <regex>
 
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
@@ -63,6 +63,42 @@ void appendUtf8(std::string& out, std::uint32_t cp) {
   }
 }
 
+bool isWordChar(char c) {
+  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+}
+std::string lowerAscii(std::string s) {
+  for (auto& c : s)
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  return s;
+}
+std::size_t skipBlanks(const std::string& s, std::size_t i) {
+  while (i < s.size() && (s[i] == ' ' || s[i] == '\t')) ++i;
+  return i;
+}
+
+// An XML declaration's encoding="UTF-16" (or utf-16, UTF-16LE/BE, UTF16) relabelled UTF-8.
+std::string relabelUtf16Declaration(std::string decl) {
+  const std::size_t k = lowerAscii(decl).find("encoding");
+  if (k == std::string::npos) return decl;
+  std::size_t i = skipBlanks(decl, k + 8);
+  if (i >= decl.size() || decl[i] != '=') return decl;
+  i = skipBlanks(decl, i + 1);
+  if (i >= decl.size() || (decl[i] != '"' && decl[i] != '\'')) return decl;
+  const char quote = decl[i];
+  const std::size_t close = decl.find(quote, i + 1);
+  if (close == std::string::npos) return decl;
+  const std::string value = lowerAscii(decl.substr(i + 1, close - i - 1));
+  if (value != "utf-16" && value != "utf16" && value != "utf-16le" && value != "utf-16be") return decl;
+  return decl.substr(0, i + 1) + "UTF-8" + decl.substr(close);
+}
+
+// The value of `key: value` or `"key": "value"` when it is a name of 1..40 word characters.
+std::string nameAfter(const std::string& s, std::size_t i) {
+  std::size_t e = i;
+  while (e < s.size() && isWordChar(s[e]) && e - i < 41) ++e;
+  return e > i && e - i <= 40 ? s.substr(i, e - i) : "";
+}
+
 // UTF-16 (after its BOM) to UTF-8; an odd length or a lone surrogate is refused.
 std::string fromUtf16(const std::string& path, const std::string& raw, bool little_endian) {
   const char* name = little_endian ? "UTF-16LE" : "UTF-16BE";
@@ -93,8 +129,7 @@ std::string fromUtf16(const std::string& path, const std::string& raw, bool litt
   if (out.rfind("<?xml", 0) == 0) {
     const std::size_t end = out.find("?>");
     if (end != std::string::npos && end < 400) {
-      static const std::regex enc(R"(encoding\s*=\s*(["'])[Uu][Tt][Ff]-?16(?:[LlBb][Ee])?(["']))");
-      out = std::regex_replace(out.substr(0, end), enc, "encoding=$1UTF-8$2") + out.substr(end);
+      out = relabelUtf16Declaration(out.substr(0, end)) + out.substr(end);
     }
   }
   return out;
@@ -185,9 +220,16 @@ std::string describeContent(const std::string& text) {
     return "an XML document";
   }
   if (head[0] == '{' || head[0] == '[') {
-    static const std::regex kind(R"re("kind"\s*:\s*"([A-Za-z0-9_]{1,40})")re");
-    std::smatch m;
-    if (std::regex_search(head, m, kind)) return "a JSON document (kind: " + m[1].str() + ")";
+    const std::size_t k = head.find("\"kind\"");
+    if (k != std::string::npos) {
+      std::size_t i = head.find_first_not_of(" \t\r\n", k + 6);
+      if (i != std::string::npos && head[i] == ':') i = head.find_first_not_of(" \t\r\n", i + 1);
+      if (i != std::string::npos && head[i] == '"') {
+        const std::string name = nameAfter(head, i + 1);
+        if (!name.empty() && i + 1 + name.size() < head.size() && head[i + 1 + name.size()] == '"')
+          return "a JSON document (kind: " + name + ")";
+      }
+    }
     if (head.find("\"asset\"") != std::string::npos) return "a glTF scene (JSON)";
     return "a JSON document";
   }
@@ -201,27 +243,50 @@ std::string describeContent(const std::string& text) {
     q = e + 1;
     while (!l.empty() && (l.back() == '\r' || l.back() == ' ' || l.back() == '\t')) l.pop_back();
     if (l.empty() || l[0] == '#' || l == "%") continue;  // '%': a Fanuc tape mark (programs and DPRNT captures)
-    first = l.substr(0, 200);  // the regexes below recurse per character
+    first = l.substr(0, 200);
     break;
   }
   for (const char* d : {"DMISMN", "FILNAM", "DMISMD", "DMISMN/", "FILNAM/"})
     if (first.rfind(d, 0) == 0) return "a DMIS file";
   if (first.rfind("PT ", 0) == 0 || first.rfind("START ", 0) == 0) return "a probe log (PT lines)";
-  static const std::regex yaml_kind(R"(^kind:\s*([A-Za-z0-9_]{1,40})\s*\r?$)");
-  std::smatch m;
+  // A top-level `kind: name` line.
   for (std::size_t a = 0; a < head.size();) {
     std::size_t e = head.find('\n', a);
     if (e == std::string::npos) e = head.size();
-    const std::string l = head.substr(a, e - a);
-    if (std::regex_search(l, m, yaml_kind)) return "a YAML description (kind: " + m[1].str() + ")";
+    std::string l = head.substr(a, e - a);
     a = e + 1;
+    while (!l.empty() && (l.back() == '\r' || l.back() == ' ' || l.back() == '\t')) l.pop_back();
+    if (l.rfind("kind:", 0) != 0) continue;
+    const std::size_t i = skipBlanks(l, 5);
+    const std::string name = nameAfter(l, i);
+    if (!name.empty() && i + name.size() == l.size()) return "a YAML description (kind: " + name + ")";
   }
-  static const std::regex gcode(R"(^(%|O[0-9<]|N[0-9]+ *[GMO#]|G[0-9]|M[0-9]|\(|#[0-9<])[^,]*$)");
-  if (std::regex_search(first, gcode)) return "a G-code program";
+  // G-code: a first block that starts like one (a tape mark, a program number, a numbered
+  // block, a G or M word, a comment, a parameter) and holds no comma.
+  auto digit = [](char c) { return c >= '0' && c <= '9'; };
+  const auto at = [&](std::size_t i) { return i < first.size() ? first[i] : '\0'; };
+  bool gcode = false;
+  if (first.find(',') == std::string::npos) {
+    const char c0 = at(0), c1 = at(1);
+    if (c0 == '%' || c0 == '(' || ((c0 == 'G' || c0 == 'M') && digit(c1)) || (c0 == 'O' && (digit(c1) || c1 == '<')) ||
+        (c0 == '#' && (digit(c1) || c1 == '<'))) {
+      gcode = true;
+    } else if (c0 == 'N' && digit(c1)) {
+      std::size_t i = 1;
+      while (digit(at(i))) ++i;
+      i = skipBlanks(first, i);
+      gcode = at(i) == 'G' || at(i) == 'M' || at(i) == 'O' || at(i) == '#';
+    }
+  }
+  if (gcode) return "a G-code program";
   if (first.find(',') != std::string::npos || first.find(';') != std::string::npos)
     return "a CSV table (first line '" + first.substr(0, 60) + (first.size() > 60 ? "...'" : "'") + ")";
-  static const std::regex yaml_key(R"(^[A-Za-z_][A-Za-z0-9_ ]*:( |$))");
-  if (std::regex_search(first, yaml_key)) return "a YAML document";
+  // `key:` or `key: value`: a YAML mapping.
+  if (!first.empty() && (std::isalpha(static_cast<unsigned char>(first[0])) || first[0] == '_')) {
+    std::size_t i = 0;
+    while (i < first.size() && (isWordChar(first[i]) || first[i] == ' ')) ++i;
+    if (i < first.size() && first[i] == ':' && (i + 1 == first.size() || first[i + 1] == ' ')) return "a YAML document";
+  }
   return "";
 }
 

@@ -96,6 +96,9 @@ TEST_F(InputFile, Utf16WithBomIsTranscoded) {
   }
   const std::string want = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<a>\xC2\xB5m \xF0\x9D\x9C\x8E</a>\n";
   EXPECT_EQ(readFile(write("le.qif", le)), want);
+  std::string single = "\xFF\xFE";
+  for (char c : std::string("<?xml version='1.0' encoding = 'utf-16le'?><a/>")) single += c, single += '\0';
+  EXPECT_EQ(readFile(write("single.qif", single)), "<?xml version='1.0' encoding = 'UTF-8'?><a/>");
   EXPECT_EQ(readFile(write("be.qif", be)), want);
   expectHas(refusal(write("odd.csv", le + "x")), "UTF-16LE (byte-order mark) but has an odd number of bytes");
   expectHas(refusal(write("lone.csv", std::string("\xFF\xFE\x00\xD8\x41\x00", 6))), "lone surrogate");
@@ -124,6 +127,11 @@ TEST(DescribeContent, NamesTheKindsProbeloopMeets) {
   EXPECT_EQ(describeContent("feature,point,x_mm\n"), "a CSV table (first line 'feature,point,x_mm')");
   EXPECT_EQ(describeContent(""), "an empty file");
   EXPECT_EQ(describeContent("hello world\n"), "");
+  EXPECT_EQ(describeContent("{ \"kind\" : \"machine_truth\", \"x\": 1}"), "a JSON document (kind: machine_truth)");
+  EXPECT_EQ(describeContent("N10 G0 X1. Y2.\n"), "a G-code program");
+  EXPECT_EQ(describeContent("N10 X1, Y2\n"), "a CSV table (first line 'N10 X1, Y2')");
+  EXPECT_EQ(describeContent("title: a model\nkind: gum_model\r\n"), "a YAML description (kind: gum_model)");
+  EXPECT_EQ(describeContent("title: a model\n"), "a YAML document");
 }
 
 // A hostile token (a 5 MB line) is echoed in a few dozen characters, with its length.
