@@ -30,12 +30,14 @@ double clockSeconds(const std::string& date, const std::string& time, const std:
 
 }  // namespace
 
-std::vector<LoggedProbePoint> parseProbeLog(const std::string& text, const std::string& file) {
+std::vector<LoggedProbePoint> parseProbeLog(const std::string& text, const std::string& file, int first_line,
+                                            std::optional<double>* session_start_s) {
   std::vector<LoggedProbePoint> out;
-  std::optional<double> start;  // the first START line's clock
+  std::optional<double> own_start;  // the first START line's clock
+  std::optional<double>& start = session_start_s ? *session_start_s : own_start;
   std::istringstream in(text);
   std::string line;
-  int n = 0;
+  int n = first_line - 1;
   while (std::getline(in, line)) {
     ++n;
     if (!line.empty() && line.back() == '\r') line.pop_back();

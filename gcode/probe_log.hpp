@@ -21,6 +21,10 @@ struct LoggedProbePoint {
   std::optional<double> time_s;  // since the log's first START, when both carry the clock
 };
 
-std::vector<LoggedProbePoint> parseProbeLog(const std::string& text, const std::string& file);
+// A log read in pieces (the campaign store follows a growing log): `first_line` is the file
+// line of the text's first line, and `session_start_s` carries the first START's clock from one
+// piece to the next (read and updated when given).
+std::vector<LoggedProbePoint> parseProbeLog(const std::string& text, const std::string& file, int first_line = 1,
+                                            std::optional<double>* session_start_s = nullptr);
 
 }  // namespace probeloop::gcode

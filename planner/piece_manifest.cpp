@@ -32,6 +32,33 @@ void setManifestMachine(parts::PlanManifest& m, const parts::Machine& machine) {
   m.probe_tool_change_repeatability_2sigma_um = machine.probe.tool_change_repeatability_2sigma_um;
 }
 
+void setManifestPiece(parts::PlanManifest& m, const std::string& kind, parts::Dialect dialect,
+                      const std::vector<NotedProgram>& programs, const std::vector<double>& start_s,
+                      const std::vector<double>& duration_s, const parts::Machine& machine, double tip_radius_mm,
+                      double probe_repeatability_2sigma_um, const std::string& part_name,
+                      const Eigen::Vector3d& part_origin_mm, const parts::WorkpieceMaterial& material) {
+  m.kind = kind;
+  m.dialect = parts::dialectName(dialect);
+  setManifestPrograms(m, programs, start_s, duration_s);
+  setManifestMachine(m, machine);
+  m.tip_radius_mm = tip_radius_mm;
+  m.probe_repeatability_2sigma_um = probe_repeatability_2sigma_um;
+  m.part_name = part_name;
+  m.part_origin_mm = part_origin_mm;
+  m.material_name = material.name;
+  m.material_alpha_um_per_m_K = material.alpha_um_per_m_K;
+}
+
+void setManifestProbingCycle(parts::PlanManifest& m, const std::vector<double>& start_s,
+                             const std::vector<double>& duration_s) {
+  setFeatureCutTimes(m);  // the cycle and the mid time of the cut(s) that finish each feature
+  const std::size_t last = start_s.size() - 1;
+  m.cycles = 1;
+  m.gap_s = 0;
+  m.cycle_time_s = duration_s[last];
+  m.cycle_start_s = {start_s[last]};
+}
+
 void setFeatureCutTimes(parts::PlanManifest& m) {
   for (auto& f : m.features) {
     double first = INFINITY, last = -INFINITY;

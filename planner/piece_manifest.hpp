@@ -9,6 +9,7 @@
 
 #include "parts/machine.hpp"
 #include "parts/plan_manifest.hpp"
+#include "parts/workpiece.hpp"
 #include "planner/program_walker.hpp"
 
 namespace probeloop::planner {
@@ -20,6 +21,20 @@ void setManifestPrograms(parts::PlanManifest& m, const std::vector<NotedProgram>
 // The machine block (name, C axis, table, coordinate resolution) and the probe's tool number
 // and tool-change repeatability; the tip radius and the probe's repeatability are the caller's.
 void setManifestMachine(parts::PlanManifest& m, const parts::Machine& machine);
+
+// What every machined piece's manifest states alike, in this order: its kind and dialect, the
+// programs (setManifestPrograms), the machine (setManifestMachine), the tip radius and the
+// probe's repeatability, the part's name, origin and material.
+void setManifestPiece(parts::PlanManifest& m, const std::string& kind, parts::Dialect dialect,
+                      const std::vector<NotedProgram>& programs, const std::vector<double>& start_s,
+                      const std::vector<double>& duration_s, const parts::Machine& machine, double tip_radius_mm,
+                      double probe_repeatability_2sigma_um, const std::string& part_name,
+                      const Eigen::Vector3d& part_origin_mm, const parts::WorkpieceMaterial& material);
+
+// The features' cut times (setFeatureCutTimes) and one probing cycle: the last program, on the
+// planned clock.
+void setManifestProbingCycle(parts::PlanManifest& m, const std::vector<double>& start_s,
+                             const std::vector<double>& duration_s);
 
 // Each feature finished by cuts: the cycle (or step) of its cuts and the mid-time from the
 // first cut's start to the last one's end; features without a cut are left as they are.
