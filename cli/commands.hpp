@@ -23,5 +23,6 @@ Subcommand addCheckCommand(CLI::App& app);
 Subcommand addEvaluateCommand(CLI::App& app);
 Subcommand addFitCommand(CLI::App& app);
 Subcommand addGumCommand(CLI::App& app);
+Subcommand addCampaignCommands(CLI::App& app);  // campaign init | ingest | status | export
 
 }  // namespace probeloop::cli

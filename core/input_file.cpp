@@ -167,26 +167,46 @@ std::string regularFileProblem(const std::string& path) {
   return p.empty() ? p : path + ": " + p;
 }
 
+namespace {
+
+// A regular file opened for reading (`actual` may be a pending output's temporary, `path` names
+// it in messages), its size checked against the cap; closed when it goes out of scope.
+struct OpenInput {
+  int fd = -1;
+  std::size_t size = 0;
+  OpenInput(const std::string& path, const std::string& actual, const InputLimit& limit) {
+    const std::string problem = problemOf(actual);
+    if (!problem.empty()) throw InputError(path, 0, problem);
+    // O_NONBLOCK: if a FIFO took the file's place since the check, open() returns at once
+    // instead of waiting for a writer; fstat below then refuses it.
+    fd = ::open(actual.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) throw InputError(path, 0, std::string("cannot open: ") + std::strerror(errno));
+    struct stat st {};
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+      ::close(fd);
+      throw InputError(path, 0, "is not a regular file (it changed while opened)");
+    }
+    size = static_cast<std::size_t>(st.st_size);
+    if (size > limit.max_bytes) {
+      ::close(fd);
+      throw InputError(path, 0, "the file has " + mib(size) + ", more than the " + mib(limit.max_bytes) + " " + limit.what +
+                                    " may have: not read (is it the right file?)");
+    }
+  }
+  ~OpenInput() { ::close(fd); }
+  OpenInput(const OpenInput&) = delete;
+  OpenInput& operator=(const OpenInput&) = delete;
+};
+
+}  // namespace
+
 std::string readFile(const std::string& path, const InputLimit& limit) {
   // An output this command wrote earlier (an open OutputBatch): its pending content.
   const std::string pending = pendingOutput(path);
   const std::string& actual = pending.empty() ? path : pending;
-  const std::string problem = problemOf(actual);
-  if (!problem.empty()) throw InputError(path, 0, problem);
-  // O_NONBLOCK: if a FIFO took the file's place since the check, open() returns at once
-  // instead of waiting for a writer; fstat below then refuses it.
-  const int fd = ::open(actual.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) throw InputError(path, 0, std::string("cannot open: ") + std::strerror(errno));
-  struct Closer {
-    int fd;
-    ~Closer() { ::close(fd); }
-  } closer{fd};
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) throw InputError(path, 0, "is not a regular file (it changed while opened)");
-  const auto size = static_cast<std::size_t>(st.st_size);
-  if (size > limit.max_bytes)
-    throw InputError(path, 0, "the file has " + mib(size) + ", more than the " + mib(limit.max_bytes) + " " + limit.what +
-                                  " may have: not read (is it the right file?)");
+  const OpenInput in(path, actual, limit);
+  const int fd = in.fd;
+  const std::size_t size = in.size;
   std::string raw;
   raw.resize(size + 1);  // one byte more: a file that grew while being read is noticed
   std::size_t got = 0;
@@ -206,6 +226,30 @@ std::string readFile(const std::string& path, const InputLimit& limit) {
   }
   raw.resize(got);
   return decode(path, std::move(raw), limit.binary);
+}
+
+FileTail readFileTail(const std::string& path, std::size_t offset, const InputLimit& limit) {
+  const OpenInput in(path, path, limit);
+  const int fd = in.fd;
+  FileTail t;
+  t.file_size = in.size;
+  if (t.file_size < offset) return t;  // shrank: the caller decides what that means
+  // Only up to the size seen now: a writer appending meanwhile is read next time.
+  t.bytes.resize(t.file_size - offset);
+  std::size_t got = 0;
+  while (got < t.bytes.size()) {
+    const ssize_t n = ::pread(fd, t.bytes.data() + got, t.bytes.size() - got, static_cast<off_t>(offset + got));
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      throw InputError(path, 0, std::string("read failed: ") + std::strerror(errno));
+    }
+    if (n == 0) break;
+    got += static_cast<std::size_t>(n);
+  }
+  t.bytes.resize(got);
+  if (t.bytes.find('\0') != std::string::npos)
+    throw InputError(path, 0, "a NUL byte after byte " + std::to_string(offset) + ": the file is not text (or was overwritten)");
+  return t;
 }
 
 std::string describeContent(const std::string& text) {

@@ -36,6 +36,16 @@ inline constexpr InputLimit kPointCloudInput{std::size_t{2} << 30, "a point clou
 
 std::string readFile(const std::string& path, const InputLimit& limit = kAnyInput);
 
+// The bytes a growing file (a controller log, a data logger's CSV) has from `offset` on, as they
+// are (UTF-8 text: no byte-order mark handling; a NUL byte is refused), with the same checks on
+// what the path is and the same cap on its whole size as readFile. A file shorter than `offset`
+// gives no bytes and its size, for the caller to refuse (it was replaced or truncated).
+struct FileTail {
+  std::string bytes;
+  std::size_t file_size = 0;
+};
+FileTail readFileTail(const std::string& path, std::size_t offset, const InputLimit& limit = kAnyInput);
+
 // Empty when `path` names a readable regular file (after links); else the reason, starting
 // with the path ("x.yaml: is a directory, not a file"). For command-line validation.
 std::string regularFileProblem(const std::string& path);

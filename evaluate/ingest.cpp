@@ -175,25 +175,32 @@ std::vector<ProbeRecord> readProbeRecords(const std::string& path, PointsFormat 
       throw InputError(path, 0, "this is " + kind + "; a sphere-artifact campaign is evaluated from the probe log the "
                                 "cycle writes (LinuxCNC LOG or Fanuc DPRNT: PT lines) or a points CSV");
   }
-  std::vector<ProbeRecord> out;
-  if (format == PointsFormat::PointsCsv) {
-    out = fromCsv(text, path, m);
-  } else {
-    for (const auto& p : gcode::parseProbeLog(text, path)) {
-      ProbeRecord r;
-      r.file = path;
-      r.line = p.line;
-      r.cycle = p.cycle;
-      r.position = p.position;
-      r.point = p.point;
-      r.tip_mm = p.tip_mm;
-      r.time_s = p.time_s;  // Fanuc's clock in the log, when it is there
-      out.push_back(r);
-    }
-  }
+  std::vector<ProbeRecord> out = format == PointsFormat::PointsCsv ? fromCsv(text, path, m) : probeLogRecords(text, path);
   if (out.empty())
     throw InputError(path, 0, "no probe points in the file: nothing to evaluate (expected the cycle's PT lines or points CSV rows)");
-  // Every record must belong to the plan.
+  checkRecordsBelongToPlan(out, m, path);
+  return out;
+}
+
+std::vector<ProbeRecord> probeLogRecords(const std::string& text, const std::string& path, int first_line,
+                                         std::optional<double>* session_start_s) {
+  std::vector<ProbeRecord> out;
+  for (const auto& p : gcode::parseProbeLog(text, path, first_line, session_start_s)) {
+    ProbeRecord r;
+    r.file = path;
+    r.line = p.line;
+    r.cycle = p.cycle;
+    r.position = p.position;
+    r.point = p.point;
+    r.tip_mm = p.tip_mm;
+    r.time_s = p.time_s;  // Fanuc's clock in the log, when it is there
+    out.push_back(r);
+  }
+  return out;
+}
+
+void checkRecordsBelongToPlan(const std::vector<ProbeRecord>& out, const parts::PlanManifest& m,
+                              const std::string& path) {
   const int per = m.pointsPerSphere();
   std::set<std::tuple<int, int, int>> keys;
   for (const auto& r : out) {
@@ -223,7 +230,6 @@ std::vector<ProbeRecord> readProbeRecords(const std::string& path, PointsFormat 
                                          " mm from its planned contact: the log does not match "
                                          "the manifest " + m.file);
   }
-  return out;
 }
 
 void applyCycleStarts(parts::PlanManifest& m, const std::string& path) {

@@ -39,6 +39,16 @@ struct ProbeRecord {
 std::vector<ProbeRecord> readProbeRecords(const std::string& path, PointsFormat format,
                                           const parts::PlanManifest& manifest);
 
+// The two steps of readProbeRecords, for a reader that receives a log in pieces (the campaign
+// store): the records of a probe log's text (LinuxCNC LOG or Fanuc DPRNT; `first_line` is the
+// file line of the text's first line, `session_start_s` as gcode::parseProbeLog), and the check that every record belongs to the plan
+// (cycle, position and point planned, none twice among `records`, each within 10 mm of its
+// planned contact: farther means a log of another plan). InputError with file:line.
+std::vector<ProbeRecord> probeLogRecords(const std::string& text, const std::string& file, int first_line = 1,
+                                         std::optional<double>* session_start_s = nullptr);
+void checkRecordsBelongToPlan(const std::vector<ProbeRecord>& records, const parts::PlanManifest& manifest,
+                              const std::string& file);
+
 // A user's file of cycle start times (`evaluate --cycle-starts`): CSV `cycle,start_s` (the
 // separators and decimal marks of core/csv.hpp), the cycles 1, 2, … N in order, each once, the
 // starts strictly increasing, N at most the plan's cycles. They replace the plan's schedule

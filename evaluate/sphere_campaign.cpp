@@ -1,5 +1,6 @@
 #include "evaluate/sphere_campaign.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -42,6 +43,14 @@ std::vector<Vector3d> centresOf(const CycleEvaluation& c, const std::vector<int>
 }
 
 }  // namespace
+
+std::vector<ScatterTerm> scatterTerms(const CycleEvaluation& c) {
+  std::vector<ScatterTerm> out;
+  for (const auto& s : c.spheres)
+    if (s.free_radius && s.free_radius->dof > 0)
+      out.push_back({c.cycle, s.position, s.free_radius->rms_mm * s.free_radius->rms_mm * s.points, double(s.free_radius->dof)});
+  return out;
+}
 
 CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& m,
                                           const std::vector<ProbeRecord>& records,
@@ -139,13 +148,17 @@ CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& m,
   // Type A scatter of the points: pooled residuals of every free-radius fit. (Not the
   // known-radius fits: the probe's mean pre-travel shrinks the apparent radius, a systematic
   // misfit that cancels between cycles but would read as scatter there.)
+  std::vector<ScatterTerm> terms = opt.prior_scatter;
+  for (const auto& c : out.cycles) {
+    const auto t = scatterTerms(c);
+    terms.insert(terms.end(), t.begin(), t.end());
+  }
+  std::stable_sort(terms.begin(), terms.end(), [](const ScatterTerm& a, const ScatterTerm& b) { return a.cycle < b.cycle; });
   double ssr = 0, dof = 0;
-  for (const auto& c : out.cycles)
-    for (const auto& s : c.spheres)
-      if (s.free_radius && s.free_radius->dof > 0) {
-        ssr += s.free_radius->rms_mm * s.free_radius->rms_mm * s.points;
-        dof += s.free_radius->dof;
-      }
+  for (const auto& t : terms) {
+    ssr += t.ssr_mm2;
+    dof += t.dof;
+  }
   out.point_scatter.type_b_sigma_mm = m.probe_repeatability_2sigma_um / 2.0 * 1e-3;
   if (dof > 0) {
     out.point_scatter.type_a_sigma_mm = std::sqrt(ssr / dof);

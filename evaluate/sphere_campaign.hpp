@@ -27,9 +27,21 @@
 
 namespace probeloop::evaluate {
 
+// One sphere's share of the pooled type-A point scatter: rms^2 x points of its free-radius
+// fit (mm^2) and its degrees of freedom.
+struct ScatterTerm {
+  int cycle = 0, position = 0;
+  double ssr_mm2 = 0, dof = 0;
+};
+
 struct EvaluateOptions {
   bool known_radius = true;  // centre from the known-radius fit (R_sphere + r_tip)
   double coverage_k = 2.0;
+  // Terms of cycles evaluated before and not passed in (a campaign store evaluates each new
+  // cycle with the reference cycle alone), in cycle order: pooled in cycle order with those of
+  // the cycles passed in, so that the result is the one of evaluating all those cycles at once,
+  // to the last bit.
+  std::vector<ScatterTerm> prior_scatter;
 };
 
 struct SphereMeasurement {
@@ -77,6 +89,10 @@ struct CampaignEvaluation {
   // the drift between cycles; Table 5.3 measured one position continuously).
   std::vector<std::pair<int, CentreRepeatability>> centre_repeatability;
 };
+
+// The terms a cycle adds to the pooled scatter, in manifest order (spheres whose free-radius fit
+// has dof > 0).
+std::vector<ScatterTerm> scatterTerms(const CycleEvaluation& c);
 
 CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& manifest,
                                           const std::vector<ProbeRecord>& records,

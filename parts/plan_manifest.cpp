@@ -398,9 +398,10 @@ PieceKind PlanManifest::pieceKind() const {
   throw InputError(file, 0, "manifest kind '" + kind + "': plans are made for sphere_artifact, thermal_test_piece and stepped_workpiece");
 }
 
-PlanManifest readManifest(const std::string& path) {
+PlanManifest readManifest(const std::string& path) { return parseManifest(readFile(path, kJsonInput), path); }
+
+PlanManifest parseManifest(const std::string& text, const std::string& path) {
   ordered_json j;
-  const std::string text = readFile(path, kJsonInput);
   try {
     j = ordered_json::parse(text);
   } catch (const ordered_json::parse_error& e) {

@@ -163,5 +163,7 @@ struct PlanManifest {
 
 std::string manifestToJson(const PlanManifest& m);
 PlanManifest readManifest(const std::string& path);  // InputError on any inconsistency
+// The same from the manifest's text (a campaign store keeps it); `file` names it in errors.
+PlanManifest parseManifest(const std::string& text, const std::string& file);
 
 }  // namespace probeloop::parts

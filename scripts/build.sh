@@ -1,7 +1,12 @@
 #!/usr/bin/env bash
 # Configures and builds into $1 (default build/) with extra CMake arguments after it.
+# A new build folder uses Ninja when it is installed (scripts/setup.sh installs it): it keeps
+# both cores compiling across library boundaries, where make waits for each library to be
+# archived (docs/performance.md#build-time). A folder configured earlier keeps its generator.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dir=${1:-build}; shift || true
-cmake -S . -B "$dir" -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
+generator=()
+if [ ! -f "$dir/CMakeCache.txt" ] && command -v ninja >/dev/null 2>&1; then generator=(-G Ninja); fi
+cmake -S . -B "$dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release "$@" >/dev/null
 cmake --build "$dir" -j"$(nproc)"
