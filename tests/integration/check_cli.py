@@ -16,12 +16,18 @@
    meets the sphere), exit 3, the finding on stderr, nothing written.
 4. `--json`; bad input is exit 2 with file:line.
 
+The edits of sections 2 and 5 are in unsafe_edits.py (shared with linuxcnc_safety.py, which runs the
+LinuxCNC ones on LinuxCNC in simulation).
+
 Needs $PROBELOOP and $PROBELOOP_SOURCE_DIR.
 """
 import json, os, re, shutil, subprocess, sys, tempfile, time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks  # noqa: E402
+from unsafe_edits import (first, off_travel, rapid_through_sphere, no_contact_check, no_trigger_check,  # noqa: E402
+                          unprotected_descent, c_below_clearance, spindle_with_probe, rapid_through_stock,
+                          NONFINITE, insert_after, rapid_only)
 
 PL = os.environ["PROBELOOP"]
 SRC = os.environ["PROBELOOP_SOURCE_DIR"]
@@ -88,64 +94,6 @@ def edited(src, name, edit):
     path = f"{W}/{name}" + os.path.splitext(src)[1]
     open(path, "w").write("\n".join(lines))
     return path, expect, allowed
-
-
-def first(lines, pattern, start=0):
-    for i in range(start, len(lines)):
-        if re.match(pattern, lines[i]):
-            return i
-    raise AssertionError(f"no line matches {pattern}")
-
-
-def off_travel(lines):  # the tool-change height 20 mm above the Z travel (500 mm)
-    i = first(lines, r"G53 G0 Z500\.0000")
-    lines[i] = "G53 G0 Z520.0000"
-    return lines, ("travel", i + 1), set()
-
-
-def rapid_through_sphere(lines):  # a retract to Z80 instead of the clearance plane: the next XY rapid crosses the sphere
-    i = first(lines, r"G0 Z113\.0000", first(lines, r"\(LOG,PT|DPRNT\[PT"))
-    lines[i] = "G0 Z80.0000"
-    return lines, ("collision", i + 2), {("positioning-unprotected", i + 2)}
-
-
-def no_contact_check(lines):  # the #5070 check after the first protected move removed
-    i = first(lines, r"G38\.3 ")
-    del lines[i + 1:i + 4]
-    return lines, ("probe-unprotected", i + 1), set()
-
-
-def unprotected_descent(lines):  # the protected descent beside the sphere as a plain rapid
-    i = first(lines, r"G38\.3 ")
-    lines[i] = "G0" + lines[i][len("G38.3"):lines[i].index(" F")]
-    del lines[i + 1:i + 4]
-    return lines, ("positioning-unprotected", i + 1), set()
-
-
-def c_below_clearance(lines):  # C indexed to 90 deg with the tip 3 mm above the sphere's top
-    i = first(lines, r"G0 C90\.000")
-    assert lines[i - 1] == "G0 Z113.0000", lines[i - 1]
-    lines[i - 1] = "G0 Z100.0000"  # itself a descent toward the sphere, and the next rapid closes in on it turned
-    return lines, ("rotary-below-clearance", i + 1), {("positioning-unprotected", i), ("positioning-unprotected", i + 2)}
-
-
-def spindle_with_probe(lines):  # M3 right after the probe comes in
-    i = first(lines, r"G43 H99")
-    lines.insert(i + 1, "S1000 M3")
-    return lines, ("spindle-with-probe", i + 2), set()
-
-
-def no_trigger_check(lines):  # Fanuc: the measuring G31's skip-position check removed
-    i = first(lines, r".*PROBE DID NOT TRIGGER")
-    del lines[i]
-    return lines, ("probe-unprotected", i), set()
-
-
-def rapid_through_stock(lines):  # roughing: the rapid to level 2's start goes down to Z60 on its way, through level 1's floor
-    i = first(lines, r"G0 Z85\.0000", first(lines, r"G1 ") + 1)
-    j = first(lines, r"G0 X", i)
-    lines[j] = lines[j] + " Z60.0000"
-    return lines, ("collision", j + 1), set()
 
 
 sphere_lc = dirs[("sphere", "linuxcnc_rotary_mill", "linuxcnc", None)]
@@ -216,21 +164,11 @@ check("a word the interpreter does not model: exit 2 with file:line", code == 2 
 # Before: an overflow to infinity, inf - inf = NaN, a move to it, then an ordinary rapid into the
 # stock passed as "safe: 0 findings" (a NaN compares false with every limit). Now the program
 # cannot be evaluated: exit 2 naming the line and the expression, never "safe".
-BIG = "1" + "0" * 308  # 1e308: finite; ten times it is not
-nonfinite = [
-    # (name, source program, inserted lines after the probe comes in, the line (offset) refused, text)
-    ("nan_then_rapid_into_sphere", f"{sphere_lc}/sphere_cycle.ngc", "G43 H99",
-     ["#901 = [EXP[1000]]", "#902 = [#901 - #901]", "G0 Z#902", "G0 Z80.0000"], 1, "EXP in"),
-    ("overflowing_coordinate", f"{sphere_lc}/sphere_cycle.ngc", "G43 H99", [f"G0 Z[{BIG} * 10]"], 1, "a product in"),
-    ("nan_plunge_fanuc", f"{sphere_fa}/sphere_cycle.nc", "G43 H99",
-     ["#901=EXP[1000.]", "#902=#901-#901", "G1 Z#902 F100."], 1, "EXP in"),
-    ("offset_overflow_fanuc", f"{sphere_fa}/sphere_cycle.nc", "G43 H99",
-     [f"#901={BIG}.", "G0 X[#901+#901]"], 2, "a sum in"),
-]
+# The programs: unsafe_edits.NONFINITE (shared with linuxcnc_safety.py).
+nonfinite = [(name, f"{sphere_lc}/sphere_cycle.ngc" if dialect == "linuxcnc" else f"{sphere_fa}/sphere_cycle.nc",
+              after, insert, bad, text) for name, dialect, after, insert, bad, text in NONFINITE]
 for name, src, after, insert, bad, text in nonfinite:
-    lines = open(src).read().split("\n")
-    i = first(lines, after)
-    lines[i + 1:i + 1] = insert
+    lines, i = insert_after(open(src).read().split("\n"), after, insert)
     path = f"{W}/{name}" + os.path.splitext(src)[1]
     open(path, "w").write("\n".join(lines))
     machine = "linuxcnc_rotary_mill" if src.endswith(".ngc") else "nmv5000"
@@ -240,9 +178,7 @@ for name, src, after, insert, bad, text in nonfinite:
           and "safe" not in o, (code, o[:300], e[:600]))
 # The same rapid into the sphere without the NaN move before it is a collision (exit 3): the NaN
 # used to hide it.
-lines = open(f"{sphere_lc}/sphere_cycle.ngc").read().split("\n")
-i = first(lines, "G43 H99")
-lines[i + 1:i + 1] = ["G0 Z80.0000"]
+lines, i = rapid_only(open(f"{sphere_lc}/sphere_cycle.ngc").read().split("\n"))
 open(f"{W}/rapid_only.ngc", "w").write("\n".join(lines))
 code, o, e = run("check", f"{W}/rapid_only.ngc", "--machine", MACHINES["linuxcnc_rotary_mill"], "--part", PIECES["sphere"])
 check("the rapid alone: a finding (exit 3)", code == 3 and "UNSAFE" in o, (code, o[:400]))
