@@ -42,7 +42,7 @@ def unprotected_descent(lines):  # the protected descent beside the sphere as a 
     return lines, ("positioning-unprotected", i + 1), set()
 
 
-def c_below_clearance(lines):  # C indexed to 90 deg with the tip 3 mm above the sphere's top
+def c_below_clearance(lines):  # C indexed to 90 deg with the tip ball 7 mm above the sphere's top (tip centre Z100, top Z90, tip radius 3)
     i = first(lines, r"G0 C90\.000")
     assert lines[i - 1] == "G0 Z113.0000", lines[i - 1]
     lines[i - 1] = "G0 Z100.0000"  # itself a descent toward the sphere, and the next rapid closes in on it turned
