@@ -122,6 +122,17 @@ struct TalcReplay {
 
 TalcReplay replayTalc(const Campaign& c, const TalcOptions& o);
 
+// The input columns TALC uses (TalcOptions::inputs, default every temperature column) and one
+// row of them at time t: linearly interpolated, held at the ends, a temperature as its change
+// since t0, "|name|" as the absolute value. InputError for a name that is not a column.
+struct TalcInputColumns {
+  std::vector<std::string> labels;  // "T_env_C - start", "|c_rpm|"
+  std::vector<int> column;
+  std::vector<char> absolute, relative;
+};
+TalcInputColumns resolveTalcInputs(const InputSeries& in, const std::vector<std::string>& asked);
+std::vector<double> talcInputRow(const TalcInputColumns& c, const InputSeries& in, double t_s, double t0_s);
+
 // Table 6.5/6.7 layout: one column per channel, rows P99 UC, P99 C (0.1 in the channel's
 // unit), reduction % (0.1); then the schedule summary and the event list.
 std::string talcText(const TalcReplay& r);
