@@ -48,6 +48,26 @@ CREATE TABLE input_source (id INTEGER PRIMARY KEY CHECK (id = 1), path TEXT NOT 
 CREATE TABLE input_samples (time_s REAL PRIMARY KEY, line INTEGER NOT NULL, text TEXT NOT NULL);
 )sql";
 
+// Schema version 2: the live TALC loop (campaign/live_loop.hpp). A version-1 store gains these
+// tables the first time a live loop opens it (upgradeToLiveSchema); every later version adds
+// its own migration there.
+const char* kSchemaV2 = R"sql(
+CREATE TABLE talc_config (id INTEGER PRIMARY KEY CHECK (id = 1), json TEXT NOT NULL);
+CREATE TABLE talc_ticks (k INTEGER PRIMARY KEY, t_s REAL NOT NULL, issued_s REAL NOT NULL, applies_s REAL NOT NULL,
+                         phase TEXT NOT NULL, model_version INTEGER);
+CREATE TABLE predictions (k INTEGER NOT NULL REFERENCES talc_ticks, channel TEXT NOT NULL, value REAL NOT NULL,
+                          PRIMARY KEY (k, channel));
+CREATE TABLE talc_measurements (cycle INTEGER PRIMARY KEY REFERENCES cycles, k INTEGER NOT NULL, t_s REAL NOT NULL,
+                                phase_before TEXT NOT NULL, taken INTEGER NOT NULL, applied_k INTEGER);
+CREATE TABLE residuals (cycle INTEGER NOT NULL REFERENCES talc_measurements, channel TEXT NOT NULL,
+                        measured REAL NOT NULL, uncompensated REAL NOT NULL, predicted REAL, residual REAL,
+                        PRIMARY KEY (cycle, channel));
+CREATE TABLE talc_events (seq INTEGER PRIMARY KEY, t_s REAL NOT NULL, channel TEXT NOT NULL, residual REAL,
+                          action TEXT NOT NULL);
+CREATE TABLE models (version INTEGER PRIMARY KEY, t_s REAL NOT NULL, reason TEXT NOT NULL, json TEXT NOT NULL);
+CREATE TABLE phases (seq INTEGER PRIMARY KEY, t_s REAL NOT NULL, phase TEXT NOT NULL);
+)sql";
+
 std::string absolute(const std::string& p) { return std::filesystem::absolute(p).lexically_normal().string(); }
 
 std::string meta(Database& db, const std::string& key) {
@@ -160,6 +180,7 @@ void CampaignStore::create(const std::string& path, const std::string& manifest_
     db.exec("PRAGMA journal_mode = DELETE");
     Transaction t(db);
     db.exec(kSchemaV1);
+    db.exec(kSchemaV2);
     db.exec("PRAGMA application_id = " + std::to_string(kApplicationId));
     db.exec("PRAGMA user_version = " + std::to_string(kStoreSchemaVersion));
     db.prepare("INSERT INTO meta (key, value) VALUES ('schema_version', ?)").bind(1, std::to_string(kStoreSchemaVersion)).run();
@@ -191,6 +212,17 @@ CampaignStore::CampaignStore(const std::string& path) : db_(path, Database::Mode
   auto m = db_.prepare("SELECT file, json FROM manifest WHERE id = 1");
   if (!m.step()) throw InputError(path, 0, "campaign store without its plan manifest");
   manifest_ = parts::parseManifest(m.text(1), path + " (manifest " + m.text(0) + ")");
+}
+
+void CampaignStore::upgradeToLiveSchema() {
+  auto v = db_.prepare("PRAGMA user_version");
+  v.step();
+  if (v.integer(0) >= 2) return;
+  Transaction tx(db_);
+  db_.exec(kSchemaV2);
+  db_.exec("PRAGMA user_version = 2");
+  db_.exec("UPDATE meta SET value = '2' WHERE key = 'schema_version'");
+  tx.commit();
 }
 
 IngestReport CampaignStore::ingestLog(const std::string& log_path, bool finished) {

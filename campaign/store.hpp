@@ -38,7 +38,7 @@
 
 namespace probeloop::campaign {
 
-constexpr int kStoreSchemaVersion = 1;
+constexpr int kStoreSchemaVersion = 2;  // 1: no live-loop tables (upgraded by the live loop)
 
 struct IngestReport {
   int lines = 0;              // complete lines read
@@ -77,6 +77,11 @@ class CampaignStore {
   StoreStatus status();
   std::string exportErrorsCsv();
   std::string exportInputsCsv();
+
+  // The live loop's tables (schema 2) on a store created as version 1; nothing if present.
+  void upgradeToLiveSchema();
+  Database& database() { return db_; }
+  const parts::PlanManifest& manifest() const { return manifest_; }
 
  private:
   Database db_;

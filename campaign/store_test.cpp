@@ -218,17 +218,43 @@ TEST_F(Fixture, StoreOfANewerSchemaIsRefusedUntouched) {
   {
     sqlite3* db = nullptr;
     ASSERT_EQ(sqlite3_open(store_path.c_str(), &db), SQLITE_OK);
-    ASSERT_EQ(sqlite3_exec(db, "PRAGMA user_version = 2", nullptr, nullptr, nullptr), SQLITE_OK);
+    const std::string newer = "PRAGMA user_version = " + std::to_string(kStoreSchemaVersion + 1);
+    ASSERT_EQ(sqlite3_exec(db, newer.c_str(), nullptr, nullptr, nullptr), SQLITE_OK);
     sqlite3_close(db);
   }
   const std::string before = bytesOf(store_path);
   try {
     CampaignStore store(store_path);
-    FAIL() << "a store of schema 2 was opened";
+    FAIL() << "a store of a newer schema was opened";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("schema version 2"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("schema version " + std::to_string(kStoreSchemaVersion + 1)), std::string::npos)
+        << e.what();
   }
   EXPECT_EQ(bytesOf(store_path), before);
+}
+
+TEST_F(Fixture, AVersion1StoreIsReadAndGainsTheLiveTablesWhenTheLiveLoopAsks) {
+  CampaignStore::create(store_path, manifest_path);
+  {  // what a store written by schema 1 looks like: no live-loop tables
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(store_path.c_str(), &db), SQLITE_OK);
+    for (const char* t : {"talc_config", "predictions", "talc_ticks", "residuals", "talc_measurements", "talc_events",
+                          "models", "phases"})
+      ASSERT_EQ(sqlite3_exec(db, (std::string("DROP TABLE ") + t).c_str(), nullptr, nullptr, nullptr), SQLITE_OK) << t;
+    ASSERT_EQ(sqlite3_exec(db, "PRAGMA user_version = 1; UPDATE meta SET value = '1' WHERE key = 'schema_version'",
+                           nullptr, nullptr, nullptr), SQLITE_OK);
+    sqlite3_close(db);
+  }
+  write(log_path, logText(2));
+  CampaignStore store(store_path);
+  store.ingestLog(log_path, true);
+  EXPECT_EQ(store.status().schema_version, 1);
+  store.upgradeToLiveSchema();
+  EXPECT_EQ(store.status().schema_version, 2);
+  auto q = store.database().prepare("SELECT COUNT(*) FROM talc_ticks");
+  ASSERT_TRUE(q.step());
+  EXPECT_EQ(q.integer(0), 0);
+  EXPECT_EQ(store.status().cycles.size(), 2u);  // what schema 1 held is kept
 }
 
 TEST_F(Fixture, OtherFilesAreNotStores) {

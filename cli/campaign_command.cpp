@@ -4,7 +4,18 @@
 #include <filesystem>
 #include <memory>
 
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+#include "campaign/dashboard.hpp"
+#include "campaign/live_loop.hpp"
 #include "campaign/store.hpp"
+#include "cli/talc_options.hpp"
+#include "model/indicators.hpp"
+#include "report/vega.hpp"
 #include "cli/commands.hpp"
 #include "cli/input_option.hpp"
 #include "core/atomic_file.hpp"
@@ -20,8 +31,111 @@ struct CampaignArgs {
   std::string store, manifest, inputs, out = ".";
   std::vector<std::string> logs, stores;
   bool finished = false;
-  CLI::App *init = nullptr, *ingest = nullptr, *status = nullptr, *exporter = nullptr;
+  CLI::App *init = nullptr, *ingest = nullptr, *status = nullptr, *exporter = nullptr, *run = nullptr;
+  // run
+  campaign::LiveOptions live;
+  std::string talc_inputs, dashboard, controller_file;
+  bool follow = false;
+  double poll_s = 2, idle_exit_s = 0;
 };
+
+volatile std::sig_atomic_t g_stop = 0;
+extern "C" void onStopSignal(int) { g_stop = 1; }
+
+// Table 6.5's layout over the compensation phase (every scored measurement after the CP).
+void printLiveSummary(const campaign::LiveLoop& loop) {
+  const auto& ms = loop.measurements();
+  int taken = 0, scored = 0;
+  for (const auto& m : ms) {
+    taken += m.taken ? 1 : 0;
+    scored += m.residual.empty() ? 0 : 1;
+  }
+  std::printf("TALC live: %s; %d cycles measured (%d fed to TALC), %d after the calibration phase\n",
+              model::talcPhaseName(loop.phase()), static_cast<int>(ms.size()), taken, scored);
+  if (scored == 0) return;
+  std::printf("%-12s", "");
+  for (const auto& c : loop.channels()) std::printf("%13s", c.c_str());
+  std::printf("\n");
+  std::vector<double> uc_p99, c_p99;
+  for (std::size_t q = 0; q < loop.channels().size(); ++q) {
+    std::vector<double> uc, cc;
+    for (const auto& m : ms)
+      if (!m.residual.empty()) {
+        uc.push_back(std::fabs(m.uncompensated[q]));
+        cc.push_back(std::fabs(m.residual[q]));
+      }
+    uc_p99.push_back(model::hazenPercentile(uc, 0.99));
+    c_p99.push_back(model::hazenPercentile(cc, 0.99));
+  }
+  auto row = [&](const char* label, auto value) {
+    std::printf("%-12s", label);
+    for (std::size_t q = 0; q < loop.channels().size(); ++q) std::printf("%13s", value(q).c_str());
+    std::printf("\n");
+  };
+  auto unit = [&](std::size_t q) { return model::channelUnit(loop.channels()[q]); };
+  row("P99_UC", [&](std::size_t q) { return formatNumber(std::round(uc_p99[q] * 10) / 10, 1) + " " + unit(q); });
+  row("P99_C", [&](std::size_t q) { return formatNumber(std::round(c_p99[q] * 10) / 10, 1) + " " + unit(q); });
+  row("Reduction", [&](std::size_t q) {
+    return formatNumber(std::round((uc_p99[q] > 0 ? 100 * (1 - c_p99[q] / uc_p99[q]) : 0) * 10) / 10, 1) + " %";
+  });
+}
+
+// What the controller side reads (a HAL component, a FOCAS writer): replaced atomically.
+void writeControllerFile(const std::string& path, const campaign::LiveLoop& loop, double now_s) {
+  nlohmann::ordered_json j;
+  j["time_s"] = now_s;
+  j["phase"] = model::talcPhaseName(loop.phase());
+  j["wait_s"] = loop.waitSeconds(now_s);
+  const auto c = loop.compensationAt(now_s);
+  if (c) {
+    nlohmann::ordered_json e;
+    for (int i = 0; i < geometry::LocationErrors::kCount; ++i) e[geometry::LocationErrors::names()[i]] = (*c)[i];
+    j["compensation"] = e;
+  } else {
+    j["compensation"] = nullptr;
+  }
+  writeFileAtomic(path, j.dump(1) + "\n");
+}
+
+int runLive(const CampaignArgs& a) {
+  campaign::CampaignStore store(a.store);
+  campaign::LiveOptions o = a.live;
+  o.talc.inputs = talcInputsFrom(a.talc_inputs);
+  campaign::LiveLoop loop(store, o);
+  if (a.follow) {
+    std::signal(SIGINT, onStopSignal);
+    std::signal(SIGTERM, onStopSignal);
+  }
+  double idle_s = 0;
+  for (;;) {
+    int added = 0;
+    bool pending = false;
+    if (!a.inputs.empty()) added += store.ingestInputs(a.inputs);
+    for (const auto& log : a.logs) {
+      const auto r = store.ingestLog(log, a.finished);
+      added += r.lines;
+      pending = pending || r.waiting_bytes > 0;
+      for (int c : r.incomplete) std::printf("cycle %d incomplete\n", c);
+    }
+    const auto p = loop.advance(a.finished, pending);
+    for (const auto& e : p.events)
+      std::printf("t = %s h  %s%s\n", formatNumber(e.t_s / 3600.0, 3).c_str(),
+                  e.channel.empty() ? "" : (e.channel + " residual " + formatNumber(e.residual, 2) + ": ").c_str(),
+                  e.action.c_str());
+    const auto s = store.status();
+    double now = s.inputs_last_time_s;
+    for (const auto& c : s.cycles) now = std::max(now, c.time_s);
+    if (!a.dashboard.empty()) writeFileAtomic(a.dashboard, campaign::liveDashboardHtml(store, loop, report::defaultVegaPath()));
+    if (!a.controller_file.empty()) writeControllerFile(a.controller_file, loop, now);
+    if (!a.follow || g_stop) break;
+    idle_s = added > 0 || p.ticks > 0 || p.measurements > 0 ? 0 : idle_s + a.poll_s;
+    if (a.idle_exit_s > 0 && idle_s >= a.idle_exit_s) break;
+    for (double slept = 0; slept < a.poll_s && !g_stop; slept += 0.05) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (g_stop) break;
+  }
+  printLiveSummary(loop);
+  return 0;
+}
 
 std::string latestErrors(const campaign::CycleStatus& c) {
   std::string s;
@@ -135,6 +249,7 @@ int runCampaign(const CampaignArgs& a) {
     }
     return code;
   }
+  if (*a.run) return runLive(a);
   campaign::CampaignStore store(a.store);
   const std::string errors = store.exportErrorsCsv(), inputs = store.exportInputsCsv();
   if (errors.empty() && inputs.empty())
@@ -154,7 +269,7 @@ int runCampaign(const CampaignArgs& a) {
 
 Subcommand addCampaignCommands(CLI::App& app) {
   auto a = std::make_shared<CampaignArgs>();
-  auto* group = app.add_subcommand("campaign", "A campaign followed in its store (SQLite) while the machine runs: init, ingest, status, export");
+  auto* group = app.add_subcommand("campaign", "A campaign followed in its store (SQLite) while the machine runs: init, ingest, run, status, export");
   group->require_subcommand(1);
   a->init = group->add_subcommand("init", "Create a campaign store for a sphere-artifact plan");
   a->init->add_option("store", a->store, "the store to create (one file, e.g. machine-7.campaign)")->required();
@@ -169,6 +284,21 @@ Subcommand addCampaignCommands(CLI::App& app) {
   a->exporter = group->add_subcommand("export", "Write errors.csv and inputs.csv, as `evaluate` and `simulate` do, for the model and report commands");
   a->exporter->add_option("store", a->store, "campaign store")->required()->check(inputFile());
   a->exporter->add_option("--out", a->out, "output folder")->capture_default_str();
+  a->run = group->add_subcommand("run", "The live TALC loop (seed 004 Ch. 6): ingest, evaluate, predict on the grid, NG phases, "
+                                         "updates; the dashboard and the controller file after every pass");
+  a->run->add_option("store", a->store, "campaign store")->required()->check(inputFile());
+  a->run->add_option("--log", a->logs, "LinuxCNC LOG or Fanuc DPRNT capture (may still be growing)")->check(inputFile());
+  a->run->add_option("--inputs", a->inputs, "inputs CSV a data logger appends to")->check(inputFile());
+  a->run->add_flag("--finished", a->finished, "the log and the inputs are complete");
+  a->run->add_flag("--follow", a->follow, "keep following the files (stop with SIGINT/SIGTERM or --idle-exit-s)");
+  a->run->add_option("--poll-s", a->poll_s, "seconds between passes when following")->capture_default_str()->check(CLI::PositiveNumber);
+  a->run->add_option("--idle-exit-s", a->idle_exit_s, "when following, stop after this long without new data (0: never)")->capture_default_str()->check(CLI::NonNegativeNumber);
+  addTalcOptions(a->run, a->live.talc, a->talc_inputs);
+  a->run->add_option("--grid-s", a->live.grid_s, "prediction grid = CP measurement interval, s (default: the plan's cycle period)")->check(CLI::PositiveNumber);
+  a->run->add_flag("--offsets-applied", a->live.offsets_applied, "the controller applies the issued offsets: a cycle measures the residual");
+  a->run->add_flag("--requested-only", a->live.requested_only, "feed TALC only the cycles it asked for (a densely measured log replayed)");
+  a->run->add_option("--dashboard", a->dashboard, "live HTML dashboard, rewritten after every pass");
+  a->run->add_option("--controller-file", a->controller_file, "JSON for the controller side: wait_s before the next cycle, the compensation in effect");
   return {group, [a] { return runCampaign(*a); }};
 }
 

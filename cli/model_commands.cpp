@@ -17,6 +17,7 @@
 #include "model/stepped_series.hpp"
 #include "model/outputs.hpp"
 #include "model/talc.hpp"
+#include "cli/talc_options.hpp"
 #include "parts/error_model_file.hpp"
 #include "parts/piece_kinds.hpp"
 #include "report/model_report.hpp"
@@ -180,9 +181,7 @@ int runTalc(const ModelArgs& a) {
   if (a.inputs.empty() || a.errors.empty()) throw InputError("", 0, "model talc: give --inputs and --errors");
   const auto c = model::loadCampaign(a.inputs, a.errors);
   model::TalcOptions o = a.talc;
-  std::stringstream ss(a.talc_inputs);
-  for (std::string s; std::getline(ss, s, ',');)
-    if (!s.empty()) o.inputs.push_back(s);
+  o.inputs = talcInputsFrom(a.talc_inputs);
   const auto r = model::replayTalc(c, o);
   std::fputs(model::talcText(r).c_str(), stdout);
   return 0;
@@ -257,17 +256,7 @@ std::function<int()> addModelCommands(CLI::App& app, CLI::App*& group) {
   auto* talc = group->add_subcommand("talc", "Adaptive replay of seed 004 Ch. 6 (TALC) over a densely measured campaign: P99 reduction as Tables 6.5/6.7");
   talc->add_option("--inputs", a->inputs, "inputs.csv of the campaign")->required()->check(cli::inputFile());
   talc->add_option("--errors", a->errors, "errors.csv of the campaign (measured densely)")->required()->check(cli::inputFile());
-  talc->add_option("--cp-h", a->talc.cp_h, "calibration phase, h (0: as short as possible)")->capture_default_str()->check(CLI::NonNegativeNumber);
-  talc->add_option("--post-interval-h", a->talc.post_interval_h, "measurement interval after the CP, h")->capture_default_str()->check(CLI::PositiveNumber);
-  talc->add_option("--ng-interval-min", a->talc.ng_interval_min, "No-Good phase measurement interval, min")->capture_default_str()->check(CLI::PositiveNumber);
-  talc->add_option("--ng-measurements", a->talc.ng_measurements, "measurements per No-Good phase")->capture_default_str()->check(CLI::PositiveNumber);
-  talc->add_option("--update-interval-h", a->talc.update_interval_h, "periodic parameter update, h (0: none)")->capture_default_str()->check(CLI::NonNegativeNumber);
-  talc->add_option("--limit-linear-um", a->talc.limit_linear_um, "action limit of the linear errors, um")->capture_default_str()->check(CLI::PositiveNumber);
-  talc->add_option("--limit-angular-urad", a->talc.limit_angular_urad, "action limit of the angular errors, urad (= um/m)")->capture_default_str()->check(CLI::PositiveNumber);
-  talc->add_option("--na", a->talc.na, "ARX output order")->capture_default_str()->check(CLI::NonNegativeNumber);
-  talc->add_option("--nb", a->talc.nb, "ARX input order (coefficients per input)")->capture_default_str()->check(CLI::PositiveNumber);
-  talc->add_option("--model-inputs", a->talc_inputs, "comma-separated input columns ('|c_rpm|' for a magnitude); default: the temperatures");
-  talc->add_option("--predicted-weight", a->talc.predicted_weight, "WLS weight of rows whose target is a prediction (Eq. 4.20)")->capture_default_str();
+  addTalcOptions(talc, a->talc, a->talc_inputs);
   talc->add_option("--cycle-duration-s", a->talc.cycle_duration_s, "duration of one measurement cycle, s (Q_Prod, Eq. 6.1)")->capture_default_str()->check(CLI::PositiveNumber);
   talc->add_flag("--include-cp", a->talc.include_cp, "P99 over the whole campaign, not only after the CP");
   auto* series = group->add_subcommand("series", "Stepped workpiece: several parts' evaluations and logged inputs -> one campaign "

@@ -321,14 +321,6 @@ std::vector<double> TalcController::measure(double t, const std::vector<double>&
     ensureGrid(k);
     for (std::size_t q = 0; q < channels_.size(); ++q) meas_[q][static_cast<std::size_t>(k)] = values[q];
     measured_[static_cast<std::size_t>(k)] = 1;
-    if (!auto_close_) return {};
-    std::string why;
-    if (cp_s_ > 0) {
-      if (t - t0_ >= cp_s_ - tol && !closeCalibration(k, k * D_, why))
-        events_.push_back({t, "", 0, "calibration phase extended: " + why});
-    } else if (k * D_ >= required_s_ - 1e-9 * D_ && inputRows() > k) {
-      closeCalibration(k, k * D_, why);  // as short as possible: the first k that identifies every channel
-    }
     return {};
   }
   advance(k);

@@ -11,12 +11,11 @@
 // a temperature as its change since t0) must be appended before index k is predicted.
 //
 // Schedule (tolerance D/4, all as the replay documents in model/talc.hpp):
-// - calibration (CP): every measurement; compensation off. With a fixed CP length the first
-//   fit is made at the first measurement at or after it (a fit that fails there extends the
-//   CP: logged, the next measurement tries again); with cp_h = 0 ("as short as possible") at
-//   the first measurement from which the thesis's and the full-rank criteria hold and every
-//   channel's fit succeeds. The CP series is the measurements with gaps interpolated (those
-//   samples weigh predicted_weight).
+// - calibration (CP): every measurement; compensation off. The driver closes it
+//   (closeCalibration: the first fit) where its rule says: the replay at the last measurement
+//   within the CP length, or at the first grid index that identifies every channel (cp_h = 0,
+//   "as short as possible"); the live loop the same, causally (campaign/live_loop.hpp). The CP
+//   series is the measurements with gaps interpolated (those samples weigh predicted_weight).
 // - compensation: measurements wanted at t_cp_end + i * post interval; after one, any
 //   |measured - predicted| beyond its action limit starts a No-Good phase of ng_measurements
 //   at the NG interval (exceedances inside it are logged as ignored); all channels are
@@ -77,6 +76,7 @@ class TalcController {
   bool calibrationFits(int k, std::string& why) const;
 
   const std::vector<TalcEvent>& events() const { return events_; }
+  void addEvent(const TalcEvent& e) { events_.push_back(e); }  // a driver's own (e.g. the CP extended)
   const std::vector<std::string>& channels() const { return channels_; }
   const std::vector<double>& limits() const { return limit_; }
   const std::vector<ArxModel>& models() const { return models_; }
@@ -87,9 +87,6 @@ class TalcController {
   int updatesAfterNg() const { return updates_after_ng_; }
   int updatesPeriodic() const { return updates_periodic_; }
   std::string ordersText() const;
-
-  // Auto-closing of the CP inside measure() (the live loop); the replay closes it itself.
-  void setAutoCloseCalibration(bool on) { auto_close_ = on; }
 
  private:
   void cpSeries(std::size_t q, int kend, Eigen::VectorXd& y, Eigen::VectorXd& w) const;
@@ -106,7 +103,6 @@ class TalcController {
   ArxOrders orders_;
   int L_ = 0;
   double D_ = 0, t0_ = 0, required_s_ = 0, cp_s_ = 0;
-  bool auto_close_ = false;
 
   std::vector<std::vector<double>> U_;        // input rows
   std::vector<std::vector<double>> meas_;     // [channel][k] measured (NaN where none)

@@ -181,11 +181,11 @@ refused("a log that shrank", ["campaign", "ingest", A, "--log", f"{W}/grow-a/sph
 newer = f"{W}/newer.campaign"
 shutil.copy(A, newer)
 db = sqlite3.connect(newer)
-db.execute("PRAGMA user_version = 2")
+db.execute("PRAGMA user_version = 3")
 db.close()
 newer_bytes = open(newer, "rb").read()
 p = run("campaign", "status", newer)
-check("a store of a newer schema: refused", p.returncode == 1 and "schema version 2" in p.stderr, p.stderr)
+check("a store of a newer schema: refused", p.returncode == 1 and "schema version 3" in p.stderr, p.stderr)
 check("a store of a newer schema: untouched", open(newer, "rb").read() == newer_bytes, "")
 p = run("campaign", "init", A, "--manifest", f"{W}/plan/plan.json")
 check("init over an existing store: refused", p.returncode == 1 and "already exists" in p.stderr, p.stderr)
