@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <map>
+#include <sstream>
 
 #include "model/dataset.hpp"
 #include "model/indicators.hpp"
@@ -156,10 +158,12 @@ std::string liveDashboardHtml(CampaignStore& store, const LiveLoop& loop, const 
       for (const auto& c : s.cycles)
         if (c.cycle == m.cycle && idx < c.U.size()) U = c.U[idx];
       json row = {{"t_s", m.t_s}, {"cycle", m.cycle}, {"uncompensated", m.uncompensated[q]}, {"U", U}};
-      if (!m.residual.empty()) {
-        row["residual"] = m.residual[q];
+      if (m.scored(loop.offsetsApplied())) {
+        // With the offsets applied the cycle measured the compensated error itself.
+        const double compensated = loop.offsetsApplied() ? m.measured[q] : m.residual[q];
+        row["residual"] = compensated;
         uc.push_back(std::fabs(m.uncompensated[q]));
-        cc.push_back(std::fabs(m.residual[q]));
+        cc.push_back(std::fabs(compensated));
       }
       measured.push_back(row);
     }
@@ -224,6 +228,45 @@ std::string liveDashboardHtml(CampaignStore& store, const LiveLoop& loop, const 
   out += page.html;
   out += "<script>\n" + vega + "\n</script>\n<script>" + kRender + "</script>\n</body>\n</html>\n";
   return out;
+}
+
+
+std::string liveSummaryText(const LiveLoop& loop) {
+  const auto& ms = loop.measurements();
+  int taken = 0, scored = 0;
+  for (const auto& m : ms) {
+    taken += m.taken ? 1 : 0;
+    scored += m.scored(loop.offsetsApplied()) ? 1 : 0;
+  }
+  std::ostringstream s;
+  s << "TALC live: " << model::talcPhaseName(loop.phase()) << "; " << ms.size() << " cycles measured (" << taken
+    << " fed to TALC), " << scored << " scored after the calibration phase"
+    << (loop.offsetsApplied() ? " with the offsets applied" : "") << "\n";
+  if (scored == 0) return s.str();
+  s << std::string(12, ' ');
+  for (const auto& c : loop.channels()) s << std::setw(13) << c;
+  s << "\n";
+  std::vector<double> uc_p99, c_p99;
+  for (std::size_t q = 0; q < loop.channels().size(); ++q) {
+    std::vector<double> uc, cc;
+    for (const auto& m : ms)
+      if (m.scored(loop.offsetsApplied())) {
+        uc.push_back(std::fabs(m.uncompensated[q]));
+        cc.push_back(std::fabs(loop.offsetsApplied() ? m.measured[q] : m.residual[q]));
+      }
+    uc_p99.push_back(model::hazenPercentile(uc, 0.99));
+    c_p99.push_back(model::hazenPercentile(cc, 0.99));
+  }
+  auto row = [&](const char* label, auto value) {
+    s << std::left << std::setw(12) << label << std::right;
+    for (std::size_t q = 0; q < loop.channels().size(); ++q) s << std::setw(13) << value(q);
+    s << "\n";
+  };
+  auto unit = [&](std::size_t q) { return model::channelUnit(loop.channels()[q]); };
+  row("P99_UC", [&](std::size_t q) { return fixed(uc_p99[q], 1) + " " + unit(q); });
+  row("P99_C", [&](std::size_t q) { return fixed(c_p99[q], 1) + " " + unit(q); });
+  row("Reduction", [&](std::size_t q) { return fixed(uc_p99[q] > 0 ? 100 * (1 - c_p99[q] / uc_p99[q]) : 0, 1) + " %"; });
+  return s.str();
 }
 
 }  // namespace probeloop::campaign

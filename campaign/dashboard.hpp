@@ -21,4 +21,9 @@ namespace probeloop::campaign {
 
 std::string liveDashboardHtml(CampaignStore& store, const LiveLoop& loop, const std::string& vega_js_path);
 
+// Table 6.5's layout over the measurements after the calibration phase: P99 (Hazen) of the
+// uncompensated error and of the compensated one (with the offsets applied: what the cycle
+// measured; replayed: the residual against the prediction), reduction; rounded to 0.1.
+std::string liveSummaryText(const LiveLoop& loop);
+
 }  // namespace probeloop::campaign

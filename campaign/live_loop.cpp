@@ -341,6 +341,7 @@ void LiveLoop::processMeasurement(const Measurement& m, bool write) {
     for (auto it = issued_.rbegin(); it != issued_.rend(); ++it)
       if (it->applies_s <= m.t_s) {
         applied_k = it->k;
+        lm.offset_applied = true;
         const auto& names = geometry::LocationErrors::names();
         for (std::size_t q = 0; q < channels_.size(); ++q) {
           const auto at = std::find(names.begin(), names.end(), channels_[q]) - names.begin();

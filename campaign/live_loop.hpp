@@ -58,11 +58,15 @@ struct LiveProgress {
   std::vector<model::TalcEvent> events;    // new events
 };
 
-// One stored measurement as TALC saw it.
+// One stored measurement as TALC saw it. Scored (Table 6.5) when it has a residual and, with
+// the offsets applied, ran with one (the first cycles after the first fit may come before
+// the first prediction is issued).
 struct LiveMeasurement {
+  bool scored(bool offsets_applied) const { return !residual.empty() && (!offsets_applied || offset_applied); }
   int cycle = 0, k = 0;
   double t_s = 0;
   bool taken = true;
+  bool offset_applied = false;  // the cycle ran with an issued offset (offsets_applied mode)
   std::string phase_before;
   std::vector<double> measured, uncompensated, predicted, residual;  // predicted/residual empty in the CP
 };
@@ -86,6 +90,7 @@ class LiveLoop {
   bool started() const;
   model::TalcPhase phase() const;
   const std::vector<std::string>& channels() const { return channels_; }
+  bool offsetsApplied() const { return o_.offsets_applied; }
   const std::vector<LiveMeasurement>& measurements() const { return done_measurements_; }
 
  private:

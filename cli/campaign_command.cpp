@@ -42,44 +42,6 @@ struct CampaignArgs {
 volatile std::sig_atomic_t g_stop = 0;
 extern "C" void onStopSignal(int) { g_stop = 1; }
 
-// Table 6.5's layout over the compensation phase (every scored measurement after the CP).
-void printLiveSummary(const campaign::LiveLoop& loop) {
-  const auto& ms = loop.measurements();
-  int taken = 0, scored = 0;
-  for (const auto& m : ms) {
-    taken += m.taken ? 1 : 0;
-    scored += m.residual.empty() ? 0 : 1;
-  }
-  std::printf("TALC live: %s; %d cycles measured (%d fed to TALC), %d after the calibration phase\n",
-              model::talcPhaseName(loop.phase()), static_cast<int>(ms.size()), taken, scored);
-  if (scored == 0) return;
-  std::printf("%-12s", "");
-  for (const auto& c : loop.channels()) std::printf("%13s", c.c_str());
-  std::printf("\n");
-  std::vector<double> uc_p99, c_p99;
-  for (std::size_t q = 0; q < loop.channels().size(); ++q) {
-    std::vector<double> uc, cc;
-    for (const auto& m : ms)
-      if (!m.residual.empty()) {
-        uc.push_back(std::fabs(m.uncompensated[q]));
-        cc.push_back(std::fabs(m.residual[q]));
-      }
-    uc_p99.push_back(model::hazenPercentile(uc, 0.99));
-    c_p99.push_back(model::hazenPercentile(cc, 0.99));
-  }
-  auto row = [&](const char* label, auto value) {
-    std::printf("%-12s", label);
-    for (std::size_t q = 0; q < loop.channels().size(); ++q) std::printf("%13s", value(q).c_str());
-    std::printf("\n");
-  };
-  auto unit = [&](std::size_t q) { return model::channelUnit(loop.channels()[q]); };
-  row("P99_UC", [&](std::size_t q) { return formatNumber(std::round(uc_p99[q] * 10) / 10, 1) + " " + unit(q); });
-  row("P99_C", [&](std::size_t q) { return formatNumber(std::round(c_p99[q] * 10) / 10, 1) + " " + unit(q); });
-  row("Reduction", [&](std::size_t q) {
-    return formatNumber(std::round((uc_p99[q] > 0 ? 100 * (1 - c_p99[q] / uc_p99[q]) : 0) * 10) / 10, 1) + " %";
-  });
-}
-
 // What the controller side reads (a HAL component, a FOCAS writer): replaced atomically.
 void writeControllerFile(const std::string& path, const campaign::LiveLoop& loop, double now_s) {
   nlohmann::ordered_json j;
@@ -133,7 +95,7 @@ int runLive(const CampaignArgs& a) {
     for (double slept = 0; slept < a.poll_s && !g_stop; slept += 0.05) std::this_thread::sleep_for(std::chrono::milliseconds(50));
     if (g_stop) break;
   }
-  printLiveSummary(loop);
+  std::fputs(campaign::liveSummaryText(loop).c_str(), stdout);
   return 0;
 }
 

@@ -5,7 +5,12 @@
 #include <memory>
 
 #include "cli/commands.hpp"
+#include "campaign/dashboard.hpp"
+#include "campaign/live_loop.hpp"
+#include "campaign/sim_link.hpp"
 #include "cli/input_option.hpp"
+#include "cli/talc_options.hpp"
+#include "report/vega.hpp"
 #include "core/atomic_file.hpp"
 #include "core/paths.hpp"
 #include "parts/machine.hpp"
@@ -22,6 +27,10 @@ struct SimulateArgs {
   std::string machine, part, truth, out = ".", cmm_points, schedule;
   std::uint64_t seed = 1;
   bool trace = false;
+  // The live loop closed on the virtual machine.
+  std::string live_store, talc_inputs;
+  campaign::LiveOptions live;
+  double until_h = 0;
 };
 
 int runSimulate(const SimulateArgs& a) {
@@ -35,7 +44,24 @@ int runSimulate(const SimulateArgs& a) {
   std::vector<sim::ProgramSource> programs;
   for (const auto& f : a.programs) programs.push_back({f, readFile(f, kProgramInput), std::nullopt});
   if (!a.schedule.empty()) sim::scheduleFromManifest(programs, a.schedule);
+  if (a.until_h > 0) part.until_s = a.until_h * 3600.0;
+  // The live loop on the controller side: its store follows the log and the inputs as the
+  // machine writes them, its offsets move the axes, its wait paces the cycles.
+  std::unique_ptr<campaign::CampaignStore> store;
+  std::unique_ptr<campaign::LiveLoop> loop;
+  std::unique_ptr<campaign::StoreLiveLink> link;
+  const std::string live_dir = pathIn(a.out, "live");
+  if (!a.live_store.empty()) {
+    store = std::make_unique<campaign::CampaignStore>(a.live_store);
+    campaign::LiveOptions o = a.live;
+    o.talc.inputs = talcInputsFrom(a.talc_inputs);
+    o.offsets_applied = true;
+    loop = std::make_unique<campaign::LiveLoop>(*store, o);
+    link = std::make_unique<campaign::StoreLiveLink>(*store, *loop, live_dir);
+    part.live = link.get();
+  }
   const auto s = sim::simulatePrograms(programs, machine, part, truth, a.seed);
+  if (link) link->finish();
   std::string written;
   for (const auto& l : s.logs) {
     const std::string name = std::filesystem::path(l.name).filename().string();
@@ -67,6 +93,13 @@ int runSimulate(const SimulateArgs& a) {
   std::printf("Simulated %s on %s (seed %llu): %ld blocks, %ld probe events, %.1f h of machine time\n", what.c_str(),
               machine.name.c_str(), static_cast<unsigned long long>(a.seed), s.blocks, s.probe_events, s.end_time_s / 3600.0);
   std::printf("  wrote %spoints.csv, inputs.csv, truth.json%s in %s\n", written.c_str(), extra.c_str(), a.out.c_str());
+  if (loop) {
+    const std::string dashboard = pathIn(live_dir, "dashboard.html");
+    writeFileAtomic(dashboard, campaign::liveDashboardHtml(*store, *loop, report::defaultVegaPath()));
+    std::printf("Live TALC loop on the controller side (%d syncs): store %s, dashboard %s\n", link->syncs(),
+                a.live_store.c_str(), dashboard.c_str());
+    std::fputs(campaign::liveSummaryText(*loop).c_str(), stdout);
+  }
   return 0;
 }
 
@@ -85,6 +118,11 @@ Subcommand addSimulateCommand(CLI::App& app) {
   simc->add_option("--cmm-points", a->cmm_points, "machined part: CMM points to measure after the programs "
                    "(feature,point,x_mm,y_mm,z_mm,nx,ny,nz; or a QIF 3.0 plan or a DMIS program: then cmm_results.qif and .dmo too)")->check(inputFile());
   simc->add_flag("--trace", a->trace, "also write trace.csv: every motion, dwell and tool change with its time and line");
+  simc->add_option("--live", a->live_store, "campaign store (campaign init): run the live TALC loop while the machine runs, "
+                   "its offsets applied and its interval read by the program (Fanuc #500, LinuxCNC analog input 0)")->check(inputFile());
+  addTalcOptions(simc, a->live.talc, a->talc_inputs);
+  simc->add_option("--grid-s", a->live.grid_s, "with --live: the prediction grid, s (default: the plan's cycle period)")->check(CLI::PositiveNumber);
+  simc->add_option("--until-h", a->until_h, "stop the machine at this time, h (a live campaign's program may run longer)")->check(CLI::PositiveNumber);
   simc->add_option("--schedule", a->schedule, "plan manifest (plan.json): start each program at its planned time, the machine "
                    "off in between (the stepped workpiece's 3 h waits)")->check(inputFile());
   return {simc, [a] { return runSimulate(*a); }};

@@ -126,19 +126,22 @@ void VirtualMachine::recordToolChange(const char* source) {
 }
 
 void VirtualMachine::sample() {
-  inputs_ << formatNumber(t_, 3);
+  std::ostringstream row;
+  row << formatNumber(t_, 3);
   for (std::size_t i = 0; i < tr_.thermal.sensors.size(); ++i) {
     const auto& s = tr_.thermal.sensors[i];
     const double T = s.node < 0 ? tr_.thermal.environment.at(t_) : net_.temperatures_C()(s.node);
     const double noisy = T + sensor_offset_[i] + (s.noise_K > 0 ? s.noise_K * sensor_normal_(sensor_rng_) : 0.0);
-    inputs_ << "," << formatNumber(noisy, 3);
+    row << "," << formatNumber(noisy, 3);
   }
-  inputs_ << "," << formatNumber(cRpm(t_), 3) << "," << formatNumber(spindle_rpm_, 3) << ","
-          << formatNumber(path_speed_mm_per_min_, 3) << ","
-          << (mwfOn(t_) ? 1 : 0) << "," << tool_changes_ << "\n";
+  row << "," << formatNumber(cRpm(t_), 3) << "," << formatNumber(spindle_rpm_, 3) << ","
+      << formatNumber(path_speed_mm_per_min_, 3) << "," << (mwfOn(t_) ? 1 : 0) << "," << tool_changes_;
+  if (sample_index_ == 0) inputs_header_ = inputs_.str();
+  inputs_ << row.str() << "\n";
   tool_changes_ = 0;
   last_sample_t_ = t_;
   ++sample_index_;
+  if (live_) live_->inputSample(t_, inputs_header_, row.str());
 }
 
 double VirtualMachine::nodeRise(int node) const {

@@ -126,8 +126,10 @@ Vector3d VirtualMachine::toolError(const Vector3d& g) const {
   return d;
 }
 
+// The axes stand at the commanded position plus the live loop's external offsets (zero without one).
 Vector3d VirtualMachine::tipActual(const Vector3d& gauge) const {
-  return gauge - Vector3d(0, 0, currentToolLength()) + toolError(gauge);
+  const Vector3d axes = gauge + offset_mm_;
+  return axes - Vector3d(0, 0, currentToolLength()) + toolError(axes);
 }
 
 VirtualMachine::Artifact VirtualMachine::artifact() const {

@@ -14,7 +14,19 @@
 
 namespace probeloop::sim::detail {
 
+void VirtualMachine::atLine(int line) {
+  line_ = line;
+  if (until_s_ && t_ >= *until_s_) throw TimeLimitReached{};
+}
+
+void VirtualMachine::refreshOffsets() {
+  if (!live_) return;
+  const Vector3d tip = pos_.xyz_mm - Vector3d(0, 0, currentToolLength());
+  offset_mm_ = live_->offsetsUm(t_, tip) * 1e-3;
+}
+
 void VirtualMachine::rapid(const MachinePosition& to) {
+  refreshOffsets();
   checkTravel(to);
   checkPath(to, "rapid (G0)");
   const double t = parts::rapidSeconds(m_, to.xyz_mm - pos_.xyz_mm, to.b_deg - pos_.b_deg, to.c_deg - pos_.c_deg);
@@ -26,6 +38,7 @@ void VirtualMachine::rapid(const MachinePosition& to) {
 }
 
 void VirtualMachine::feed(const MachinePosition& to, double F) {
+  refreshOffsets();
   checkTravel(to);
   // A move of rotary axes alone reads F in deg/min (LinuxCNC and Fanuc): the axis turns at
   // F / 360 rpm, limited by its turning speed, not by the XYZ feed.
@@ -58,6 +71,7 @@ double VirtualMachine::cMoveRpm(const MachinePosition& to, double dt_s) const {
 }
 
 gcode::ProbeOutcome VirtualMachine::probe(const MachinePosition& to, double F, gcode::ProbeMode mode) {
+  refreshOffsets();
   const double t0 = t_;
   const auto r = probeMove(to, F, mode);
   traceRow(r.contact ? "probe_contact" : "probe_no_contact", to, F, t0);
@@ -65,6 +79,7 @@ gcode::ProbeOutcome VirtualMachine::probe(const MachinePosition& to, double F, g
 }
 
 void VirtualMachine::dwell(double s) {
+  refreshOffsets();
   const double t0 = t_;
   dwelling_ = true;
   advance(s);
@@ -135,6 +150,7 @@ void VirtualMachine::log(const std::string& line) {
     events_[static_cast<std::size_t>(pending_)].log_line = l.lines;
     pending_ = -1;
   }
+  if (live_) live_->logLine(t_, l.name, line);
 }
 
 // A new log of the current program; its index.

@@ -29,7 +29,7 @@ namespace detail {
 
 VirtualMachine::VirtualMachine(const parts::Machine& m, const SimulationPart& part, const MachineTruth& tr,
                                std::uint64_t seed)
-    : m_(m), a_(part.artifact), w_(part.workpiece), tr_(tr), noise_rng_(streamSeed(seed, 1)), atc_rng_(streamSeed(seed, 2)),
+    : live_(part.live), until_s_(part.until_s), m_(m), a_(part.artifact), w_(part.workpiece), tr_(tr), noise_rng_(streamSeed(seed, 1)), atc_rng_(streamSeed(seed, 2)),
       sensor_rng_(streamSeed(seed, 3)), duty_rng_(streamSeed(seed, 4)), duty_tc_rng_(streamSeed(seed, 5)),
       duty_atc_rng_(streamSeed(seed, 6)) {
   if (tr.thermal.present) {
@@ -209,9 +209,14 @@ SimulationOutputs simulatePrograms(const std::vector<ProgramSource>& programs, c
     gcode::Interpreter interp(dialect, p.file, p.text);
     if (p.start_s && *p.start_s > vm.time()) vm.machineOff(*p.start_s - vm.time());
     vm.beginProgram(p.file, last_fanuc);
-    const auto run = interp.run(vm);
+    try {
+      const auto run = interp.run(vm);
+      out.blocks += run.blocks_executed;
+    } catch (const detail::TimeLimitReached&) {  // the campaign's end: the machine stops here
+      vm.endProgram();
+      break;
+    }
     vm.endProgram();
-    out.blocks += run.blocks_executed;
   }
   vm.finish();
   if (!multi) vm.ensureLog(last_fanuc);

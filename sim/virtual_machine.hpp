@@ -46,6 +46,7 @@
 #include "parts/piece_kinds.hpp"
 #include "parts/workpiece.hpp"
 #include "sim/cmm_stage.hpp"
+#include "sim/live_link.hpp"
 #include "sim/machine_truth.hpp"
 
 namespace probeloop::sim {
@@ -85,6 +86,12 @@ struct SimulationPart {
   std::string cmm_points_file = "CMM points";  // for error messages
   std::optional<interop::CmmDocument> cmm_plan;  // the points came as a QIF plan or a DMIS program: answer in both
   bool trace = false;                // also write the motion trace
+  // A live loop on the controller side (sim/live_link.hpp): logs and samples go to it as they
+  // are written, its offsets move the axes, programs read its values. Not owned.
+  LiveLink* live = nullptr;
+  // Stop at the first block at or after this time (the machine switched off there): a
+  // campaign whose program would run longer, as a live loop's longer intervals make it.
+  std::optional<double> until_s;
 };
 
 SimulationOutputs simulateProgram(const std::string& program_file, const std::string& program_text,

@@ -40,6 +40,9 @@ namespace probeloop::sim::detail {
 using Eigen::Vector3d;
 using gcode::MachinePosition;
 
+// Thrown at the first block at or after SimulationPart::until_s: the run ends there.
+struct TimeLimitReached {};
+
 struct ProbeEvent {
   double time_s = 0;
   int log_stream = -1;  // which log of the run (index)
@@ -70,7 +73,7 @@ class VirtualMachine : public gcode::MachineInterface {
   // The controller's clock (Fanuc #3011/#3012): Monday 2026-01-05 at the truth's start_clock
   // (the hall's time of day at t = 0; midnight without one), then the simulated time.
   double controllerClockS() const override { return 4 * 86400.0 + tr_.thermal.environment.start_clock_s + t_; }
-  void atLine(int line) override { line_ = line; }
+  void atLine(int line) override;
 
   // --- gcode::MachineInterface (machine_motion.cpp) ---------------------------------------
   void rapid(const MachinePosition& to) override;
@@ -203,7 +206,13 @@ class VirtualMachine : public gcode::MachineInterface {
   void cutMove(const MachinePosition& to, double F);
   void arcCut(const MachinePosition& to, double F_deg_per_min);
 
+  // The live loop's offsets now, at the nominal tip of the current position (before a motion).
+  void refreshOffsets();
+
   // --- state ------------------------------------------------------------------------------
+  LiveLink* live_ = nullptr;
+  std::optional<double> until_s_;
+  Vector3d offset_mm_ = Vector3d::Zero();  // external offsets in effect (added to the commanded XYZ)
   const parts::Machine& m_;
   const parts::SphereArtifact* a_;
   const parts::Workpiece* w_;
@@ -242,6 +251,7 @@ class VirtualMachine : public gcode::MachineInterface {
   double settling_ = 0;                         // sum of the decaying unit jumps of the changes
   nlohmann::ordered_json tool_change_log_ = nlohmann::ordered_json::array();
   std::ostringstream inputs_;
+  std::string inputs_header_;  // the inputs CSV's lines before the first row
   long pending_ = -1;
   struct LogStream {
     std::string name;
