@@ -4,7 +4,8 @@
 // #-parameters (numbered, and LinuxCNC named #<...>), expressions with [ ], functions and
 // comparisons, LinuxCNC o-word while/if/elseif/else and Fanuc WHILE/DO/END, IF..GOTO,
 // IF..THEN, GOTO, #3000 alarms, LinuxCNC LOGOPEN/LOG/LOGCLOSE/ABORT and Fanuc
-// POPEN/DPRNT/PCLOS.
+// POPEN/DPRNT/PCLOS, and values written from outside while the program runs: Fanuc common
+// variables #500..#999 and LinuxCNC M66 E<n> L0 (an analog input into #5399).
 //
 // Contract: the interpreter owns the controller's view (program coordinates, offsets,
 // parameters, control flow) and asks a MachineInterface to move; the machine answers with
@@ -18,6 +19,7 @@
 #include <Eigen/Dense>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -63,6 +65,16 @@ class MachineInterface {
   // The controller's clock: seconds since 2026-01-01 00:00 (Fanuc reads it as #3011, the date
   // YYYYMMDD, and #3012, the time HHMMSS; LinuxCNC has no clock a program can read).
   virtual double controllerClockS() const { return 0.0; }
+  // Values the program reads from outside, at the instant it reads them (the sphere cycle's
+  // live measurement interval, planner/sphere_cycle.hpp). The defaults are a machine nobody
+  // writes to: the program sees what it stored itself, and inputs read 0.
+  // - Fanuc common variables #500..#999 (retained; a FOCAS cnc_wrmacro writer sets them while
+  //   the program runs): a value returned replaces the stored one, as if it had been written
+  //   just before the read; nullopt keeps the stored one (0 when the program never set it).
+  virtual std::optional<double> externalVariable(int /*n*/) const { return std::nullopt; }
+  // - LinuxCNC M66 E<n> L0: analog input n (HAL motion.analog-in-NN) read at once; the
+  //   interpreter stores it in #5399, as LinuxCNC does.
+  virtual double analogInput(int /*n*/) { return 0.0; }
 };
 
 struct InterpreterResult {

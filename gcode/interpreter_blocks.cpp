@@ -33,7 +33,9 @@ bool Execution::block(const std::string& code) {
     else if (letter == 'N') continue;
     else {
       static const std::string allowed = "XYZBCFSTHPLIJR";
-      if (allowed.find(letter) == std::string::npos)
+      // E: the analog input of LinuxCNC's M66 E<n> L0 (execute refuses it anywhere else).
+      const bool analog_input = letter == 'E' && in_.dialect_ == ProgramDialect::LinuxCnc;
+      if (allowed.find(letter) == std::string::npos && !analog_input)
         fail("word '" + std::string(1, letter) + "' is not modelled by the simulator");
       if (w.v.count(letter)) fail("word '" + std::string(1, letter) + "' appears twice");
       w.v[letter] = v;
@@ -87,7 +89,7 @@ bool Execution::execute(Words& w) {
     if (feed_ < 0) fail("F must not be negative");
   }
   if (w.has('T')) tool_selected_ = wholeWord(w, 'T', 0, 9999);
-  bool spindle_word = false, end = false;
+  bool spindle_word = false, end = false, m66 = false;
   if (w.has('S')) {
     spindle_rpm_ = w.take('S');
     if (spindle_rpm_ < 0) fail("S must not be negative");
@@ -109,9 +111,14 @@ bool Execution::execute(Words& w) {
     } else if (mi == 8) m_.coolant(true);
     else if (mi == 9) m_.coolant(false);
     else if (mi == 2 || mi == 30) end = true;  // after the rest of the line
+    else if (mi == 66 && in_.dialect_ == ProgramDialect::LinuxCnc) m66 = true;
     else if (mi == 19) {
     }  // spindle orientation: the probe's angular position is fixed anyway
     else fail("M" + std::to_string(mi) + " is not modelled by the simulator");
+  }
+  if (m66) {
+    analogRead(w);
+    return end;
   }
   // A new S while the spindle turns takes effect at once.
   if (w.has('S') && !spindle_word && spindle_dir_ != 0) m_.spindle(spindle_dir_ * spindle_rpm_);
@@ -146,6 +153,25 @@ bool Execution::execute(Words& w) {
   else if (g31 || g53) fail("G31/G53 without an axis word");
   finishWords(w);
   return end;
+}
+
+void Execution::analogRead(Words& w) {
+  // The one form the planner emits (the sphere cycle's live interval): an immediate read of an
+  // analog input. The other forms wait on an input or read a digital one; a run that took
+  // them for this would time and branch differently from the controller, so they are refused.
+  const std::string form = "only M66 E<n> L0 (read analog input n at once into #5399) is modelled";
+  if (w.g.size() + w.m.size() != 1)
+    fail("M66 E<n> L0 must stand on a line of its own here (no G or other M code with it); " + form);
+  if (w.has('P')) fail("M66 P (a digital input) is not modelled; " + form);
+  if (!w.has('E')) fail("M66 without E<n> (the analog input); " + form);
+  if (!w.has('L')) fail("M66 without L0 (the wait mode); " + form);
+  const int n = wholeWord(w, 'E', 0, 63);  // LinuxCNC has at most 64 analog inputs (num_aio)
+  const int mode = wholeWord(w, 'L', 0, 4);
+  if (mode != 0) fail("M66 L" + std::to_string(mode) + " waits on the input; " + form);
+  finishWords(w);  // an axis or any other word on the line
+  const double v = m_.analogInput(n);
+  if (!std::isfinite(v)) fail("analog input " + std::to_string(n) + " reads a value that is not a finite number");
+  params_[5399] = v;
 }
 
 void Execution::finishWords(const Words& w) {

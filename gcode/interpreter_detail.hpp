@@ -7,7 +7,8 @@
 // Its member functions are defined by job, in the order a block is read and done:
 // - interpreter.cpp: reading the text into lines, the run (runFrom: the cursor, the block
 //   bound, errors placed at their line) and the dispatch of each line (executeLine);
-// - interpreter_expressions.cpp: numbers, parameters (#i, #<name>, Fanuc's clock #3011/#3012),
+// - interpreter_expressions.cpp: numbers, parameters (#i, #<name>, Fanuc's clock #3011/#3012
+//   and its common variables #500..#999 as written from outside),
 //   functions and operators, a word's value, and parameter assignment (#i=..., alarms #3000);
 // - interpreter_control.cpp: the control structures resolved before the run (LinuxCNC
 //   o-words, Fanuc labels and WHILE/DO/END) and taken during it (conditions, GOTO, IF THEN),
@@ -15,7 +16,7 @@
 // - interpreter_logs.cpp: what the controller writes: Fanuc DPRNT formats, LinuxCNC active
 //   comments (LOGOPEN, LOG, ABORT, ...) and their parameter substitution;
 // - interpreter_blocks.cpp: an ordinary block: its words read and checked, the modal state it
-//   sets (G, M, F, S, T, H, G10 offsets, G4 dwell), every word made to act;
+//   sets (G, M, F, S, T, H, G10 offsets, G4 dwell, M66 E<n> L0), every word made to act;
 // - interpreter_motion.cpp: motion: targets through the work offset and tool length, rapid,
 //   feed, arcs as chords, probe moves and their results (#5061.., #5070) and branches.
 #pragma once
@@ -187,7 +188,7 @@ class Execution {
   double readParam(Cursor& c);
 
   // A numbered parameter; Fanuc's #3011 (date YYYYMMDD) and #3012 (time HHMMSS) read the
-  // controller's clock.
+  // controller's clock, its #500..#999 the machine's externalVariable when it has one.
   double paramValue(int n);
 
   int paramNumber(Cursor& c);
@@ -271,6 +272,9 @@ class Execution {
   static std::string formatG(double v);
 
   bool execute(Words& w);
+
+  // LinuxCNC M66 E<n> L0: the analog input into #5399 (any other M66 form is refused).
+  void analogRead(Words& w);
 
   // Every word on a line must have done something: one that did not is refused, so a
   // program the simulator misreads never runs silently.

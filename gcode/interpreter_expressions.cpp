@@ -1,5 +1,6 @@
 // Expressions and parameters of a run (interpreter_detail.hpp): numbers, #i and #<name>, the
-// controller clock's #3011/#3012, functions and operators, a word's value, assignments.
+// controller clock's #3011/#3012, Fanuc's #500..#999 as written from outside, functions and
+// operators, a word's value, assignments.
 #include "gcode/interpreter_detail.hpp"
 
 #include <algorithm>
@@ -50,7 +51,19 @@ double Execution::readParam(Cursor& c) {  // after '#'
 }
 
 double Execution::paramValue(int n) {
-  if (in_.dialect_ != ProgramDialect::FanucMacroB || (n != 3011 && n != 3012)) return parameter(n);
+  if (in_.dialect_ != ProgramDialect::FanucMacroB) return parameter(n);
+  if (n >= 500 && n <= 999) {
+    // A retained common variable may have been written from outside since the program last
+    // looked (FOCAS cnc_wrmacro): the machine's value, when it has one, is the one read, and
+    // stays stored as if it had been written just before this read.
+    const auto v = m_.externalVariable(n);
+    if (!v) return parameter(n);
+    if (!std::isfinite(*v))
+      fail("#" + std::to_string(n) + " written from outside is not a finite number; the program cannot use it");
+    params_[n] = *v;
+    return *v;
+  }
+  if (n != 3011 && n != 3012) return parameter(n);
   const double s = std::max(0.0, m_.controllerClockS());
   const long days = static_cast<long>(std::floor(s / 86400.0));
   const long sec = static_cast<long>(std::floor(s - 86400.0 * static_cast<double>(days)));

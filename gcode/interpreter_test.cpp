@@ -2,9 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <numbers>
+#include <optional>
+#include <tuple>
 
 #include "core/error.hpp"
 #include "gcode/probe_program.hpp"
@@ -324,6 +327,176 @@ TEST(Interpreter, NonFiniteValuesStopTheProgramAtTheirLine) {
   ok.run(r);
   EXPECT_EQ(ok.parameter(1), 1e308 * 1.5);
   EXPECT_EQ(ok.parameter(2), std::exp(700.0));
+}
+
+// A live loop on the other side of the controller: at t = 0 it asks for the next cycle in
+// `wait_s` seconds and counts the value down with the machine's clock (only dwells take time
+// here), as the TALC loop's writer does; Fanuc reads it as #500, LinuxCNC as analog input 0.
+struct LiveMachine : Recorder {
+  double t_s = 0, wait_s = 150;
+  mutable std::vector<int> variables_read;
+  std::vector<int> inputs_read;
+  double remaining() const { return std::max(0.0, wait_s - t_s); }
+  void dwell(double s) override {
+    Recorder::dwell(s);
+    t_s += s;
+  }
+  std::optional<double> externalVariable(int n) const override {
+    variables_read.push_back(n);
+    return n == 500 ? std::optional<double>(remaining()) : std::nullopt;
+  }
+  double analogInput(int n) override {
+    inputs_read.push_back(n);
+    return n == 0 ? remaining() : 0.0;
+  }
+};
+
+// The dwells of a run and where they fell: the index of each among the probe moves before it.
+std::vector<std::pair<std::string, int>> dwellsAfterProbes(const Recorder& r) {
+  std::vector<std::pair<std::string, int>> out;
+  int probes = 0;
+  for (const auto& c : r.calls) {
+    if (c == "G31" || c == "G38.2") ++probes;
+    if (c.rfind("G4 ", 0) == 0) out.emplace_back(c.substr(3), probes);
+  }
+  return out;
+}
+
+ProbeProgram liveProgram() {
+  ProbeProgram p;
+  p.title = "t";
+  p.log_file = "probe.log";
+  p.cycles = 3;
+  p.gap_s = 300;  // nominal only: the program waits as told
+  p.live_interval = true;
+  p.cycle_body = {ToolChange{99, true}, Rapid{10.0, 0.0, 20.0}, ProbeMove{30, 0, 20, 200, 1, 1}};
+  return p;
+}
+
+// 150 s to wait: 60 + 60 + 30 s of dwell after the first cycle (a read after each), then 0, so
+// the third cycle follows the second at once; the fixed 300 s gap is never dwelt.
+TEST(Interpreter, TheLiveIntervalIsReadFromOutsideInBothDialects) {
+  const std::vector<std::pair<std::string, int>> want = {
+      {std::to_string(60.0), 1}, {std::to_string(60.0), 1}, {std::to_string(30.0), 1}};
+  LiveMachine fa;
+  fa.contact_x = 12.5;
+  Interpreter fanuc(ProgramDialect::FanucMacroB, "t.nc", writeFanucMacroB(liveProgram()));
+  EXPECT_TRUE(fanuc.run(fa).ended);
+  EXPECT_EQ(dwellsAfterProbes(fa), want);
+  EXPECT_EQ(fa.log_lines.size(), 3u + 3u);  // %, START, 3 points, %
+  // Read once before the wait loop and once after each dwell, after each of the 2 first cycles.
+  EXPECT_EQ(fa.variables_read, std::vector<int>(1 + 3 + 1, 500));
+  EXPECT_EQ(fanuc.parameter(500), 0.0);  // the last value read stays stored
+  EXPECT_EQ(fanuc.parameter(101), 0.0);
+
+  LiveMachine lc;
+  lc.contact_x = 12.5;
+  Interpreter linuxcnc(ProgramDialect::LinuxCnc, "t.ngc", writeLinuxCnc(liveProgram()));
+  EXPECT_TRUE(linuxcnc.run(lc).ended);
+  EXPECT_EQ(dwellsAfterProbes(lc), want);
+  EXPECT_EQ(lc.log_lines.size(), 3u);
+  EXPECT_EQ(lc.inputs_read, std::vector<int>(1 + 3 + 1, 0));
+  EXPECT_EQ(linuxcnc.parameter(5399), 0.0);
+
+  // Nothing writing the value (a machine without a live loop): the cycles run back to back.
+  for (const auto d : {ProgramDialect::FanucMacroB, ProgramDialect::LinuxCnc}) {
+    Recorder quiet;
+    quiet.contact_x = 12.5;
+    const auto p = liveProgram();
+    Interpreter in(d, "t", d == ProgramDialect::LinuxCnc ? writeLinuxCnc(p) : writeFanucMacroB(p));
+    in.run(quiet);
+    EXPECT_TRUE(dwellsAfterProbes(quiet).empty());
+  }
+  // Without the option the nominal gap is dwelt, 300 s after each cycle but the last.
+  auto fixed = liveProgram();
+  fixed.live_interval = false;
+  LiveMachine f2;
+  f2.contact_x = 12.5;
+  Interpreter in(ProgramDialect::FanucMacroB, "t.nc", writeFanucMacroB(fixed));
+  in.run(f2);
+  EXPECT_EQ(dwellsAfterProbes(f2), (std::vector<std::pair<std::string, int>>{{std::to_string(300.0), 1},
+                                                                              {std::to_string(300.0), 2}}));
+  EXPECT_TRUE(f2.variables_read.empty());
+}
+
+// The machine's value replaces the stored one only for Fanuc's #500..#999, and only when it has
+// one; LinuxCNC's #500 is a plain parameter.
+TEST(Interpreter, ExternalVariablesReplaceTheStoredValueOnlyWhereAWriterCanReachThem) {
+  struct Writer : Recorder {
+    mutable std::vector<int> asked;
+    std::optional<double> externalVariable(int n) const override {
+      asked.push_back(n);
+      return n == 999 ? std::nullopt : std::optional<double>(3.0);
+    }
+  };
+  Writer w;
+  Interpreter fa(ProgramDialect::FanucMacroB, "t.nc",
+                 "#500=7\n#999=8\n#499=9\n#1000=10\n#1=#500+#999\n#2=#499+#1000\nM30\n");
+  fa.run(w);
+  EXPECT_EQ(fa.parameter(1), 3 + 8);   // #500 as written from outside, #999 as stored
+  EXPECT_EQ(fa.parameter(2), 9 + 10);  // not common variables a FOCAS writer sets
+  EXPECT_EQ(fa.parameter(500), 3.0);   // stored, as if written just before the read
+  EXPECT_EQ(w.asked, (std::vector<int>{500, 999}));
+  Recorder nobody;
+  Interpreter fa2(ProgramDialect::FanucMacroB, "t.nc", "#500=7\n#1=#500\nM30\n");
+  fa2.run(nobody);
+  EXPECT_EQ(fa2.parameter(1), 7.0);
+  Writer w2;
+  Interpreter lc(ProgramDialect::LinuxCnc, "t.ngc", "#500 = 7\n#1 = #500\nM2\n");
+  lc.run(w2);
+  EXPECT_EQ(lc.parameter(1), 7.0);
+  EXPECT_TRUE(w2.asked.empty());
+
+  struct Broken : Recorder {
+    std::optional<double> externalVariable(int) const override { return std::nan(""); }
+    double analogInput(int) override { return INFINITY; }
+  };
+  for (const auto& [d, text, want] :
+       {std::tuple{ProgramDialect::FanucMacroB, std::string("G4 X1.\n#1=#500\n"),
+                   std::string("t:2: #500 written from outside is not a finite number")},
+        std::tuple{ProgramDialect::LinuxCnc, std::string("G4 P1\nM66 E1 L0\n"),
+                   std::string("t:2: analog input 1 reads a value that is not a finite number")}}) {
+    Broken b;
+    Interpreter in(d, "t", text);
+    try {
+      in.run(b);
+      FAIL() << "accepted " << text;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
+    }
+  }
+}
+
+// LinuxCNC M66 E<n> L0 reads analog input n into #5399; every other M66 form is refused with its
+// line, since a run that took it for an immediate read would not wait when LinuxCNC waits.
+TEST(Interpreter, M66ReadsAnAnalogInputAtOnceAndRefusesItsOtherForms) {
+  struct Inputs : Recorder {
+    std::vector<int> asked;
+    double analogInput(int n) override {
+      asked.push_back(n);
+      return 10.0 + n;
+    }
+  };
+  Inputs r;
+  Interpreter in(ProgramDialect::LinuxCnc, "t.ngc", "M66 E2 L0\n#1 = #5399\nN5 M66 E63 L0\nM2\n");
+  in.run(r);
+  EXPECT_EQ(in.parameter(1), 12.0);
+  EXPECT_EQ(in.parameter(5399), 73.0);
+  EXPECT_EQ(r.asked, (std::vector<int>{2, 63}));
+  const std::string only = "only M66 E<n> L0";
+  expectInputError(ProgramDialect::LinuxCnc, "G0 X0\nM66 P0 L0\n", "bad.ngc:2: M66 P (a digital input)");
+  expectInputError(ProgramDialect::LinuxCnc, "M66 E0 L1\n", "bad.ngc:1: M66 L1 waits on the input; " + only);
+  expectInputError(ProgramDialect::LinuxCnc, "M66 E0 L3 Q5\n", "bad.ngc:1: word 'Q' is not modelled");
+  expectInputError(ProgramDialect::LinuxCnc, "M66 E0\n", "bad.ngc:1: M66 without L0");
+  expectInputError(ProgramDialect::LinuxCnc, "M66 L0\n", "bad.ngc:1: M66 without E<n>");
+  expectInputError(ProgramDialect::LinuxCnc, "M66 E0.5 L0\n", "bad.ngc:1: E0.5: expected a whole number 0..63");
+  expectInputError(ProgramDialect::LinuxCnc, "M66 E64 L0\n", "bad.ngc:1: E64: expected a whole number 0..63");
+  expectInputError(ProgramDialect::LinuxCnc, "G4 P1 M66 E0 L0\n", "bad.ngc:1: M66 E<n> L0 must stand on a line of its own");
+  expectInputError(ProgramDialect::LinuxCnc, "M66 E0 L0 X5\n", "bad.ngc:1: word 'X5' has no effect on this line");
+  expectInputError(ProgramDialect::LinuxCnc, "G0 X1 E2\n", "bad.ngc:1: word 'E2' has no effect on this line");
+  // A Fanuc control has no M66 of its own (a machine builder's M code): not modelled.
+  expectInputError(ProgramDialect::FanucMacroB, "M66\n", "bad.ngc:1: M66 is not modelled");
+  expectInputError(ProgramDialect::FanucMacroB, "G0 X1. E2.\n", "bad.ngc:1: word 'E' is not modelled");
 }
 
 TEST(Interpreter, AnEndlessLoopIsStoppedAndNamed) {

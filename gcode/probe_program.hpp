@@ -7,6 +7,14 @@
 // `cycles` times with a dwell of `gap_s` between cycles, opens the log before the loop and
 // closes it after. Every probing op names (position, point) for the log line
 // "PT <cycle> <position> <point> <x> <y> <z>".
+//
+// With `live_interval` the wait between cycles is decided outside the program while it runs
+// (the live TALC loop, seed 004 Ch. 6): instead of the dwell of `gap_s` the program reads a
+// number of seconds still to wait and, while it is > 0, dwells min(value, 60 s) and reads it
+// again. Fanuc reads common variable #500 (retained; set by a FOCAS cnc_wrmacro writer) into
+// #101; LinuxCNC reads HAL analog input 0 with M66 E0 L0 (#5399) into #<_pl_wait>. The writer
+// decides when the next cycle is due: it counts the value down or sets it to 0. Nothing
+// writing it (0) runs the cycles back to back.
 #pragma once
 #include <string>
 #include <vector>
@@ -14,6 +22,13 @@
 #include "gcode/program.hpp"
 
 namespace probeloop::gcode {
+
+// Where the live interval comes from, and the longest dwell between two reads of it: the
+// lag with which the program sees a new value (a Fanuc control may evaluate the read after a
+// dwell as the dwell starts, buffering macro statements: then one chunk late).
+inline constexpr int kLiveIntervalFanucVariable = 500;   // read into #101 (#100 counts cycles)
+inline constexpr int kLiveIntervalLinuxCncInput = 0;     // M66 E0 L0 -> #5399 -> #<_pl_wait>
+inline constexpr double kLiveIntervalChunkS = 60.0;
 
 struct ProbeProgram {
   std::string title;
@@ -23,6 +38,7 @@ struct ProbeProgram {
   std::string log_file;             // LinuxCNC LOGOPEN name; Fanuc writes to its DPRNT device
   int cycles = 1;
   double gap_s = 0;
+  bool live_interval = false;  // the wait between cycles read from outside (above), not gap_s
   std::vector<Op> before_cycles, cycle_body, after_cycles;
 };
 

@@ -275,11 +275,70 @@ std::string writeFanucMacroB(const Program& p) {
   return o.str();
 }
 
+namespace {
+
+// The live interval's header lines (probe_program.hpp): where the wait comes from, what the
+// value means, and what happens when nothing writes it.
+std::vector<std::string> liveIntervalHeader(const ProbeProgram& p, const std::string& source) {
+  if (!p.live_interval) return {};
+  const std::string chunk = formatNumber(kLiveIntervalChunkS);
+  return {
+      "measurement interval: live, from " + source + ", read after every cycle but the last",
+      // Plain words: a Fanuc comment is safest without characters such as > or '.
+      "the value is the seconds still to wait: while it is above 0 the program dwells at most " + chunk +
+          " s and reads it again",
+      "nothing writing it (value 0): the cycles run back to back; the schedule in plan.json is nominal (gap " +
+          formatNumber(p.gap_s) + " s)",
+  };
+}
+
+// The wait between two cycles, inside the "not the last cycle" branch.
+void linuxCncWait(std::ostream& o, const ProbeProgram& p) {
+  if (!p.live_interval) {
+    o << "G4 P" << n3(p.gap_s) << "\n";
+    return;
+  }
+  // M66 L0 reads at once; LinuxCNC runs it only after the queued motion (the dwell) is done,
+  // so each read is the value at the end of the previous chunk.
+  const std::string read = "M66 E" + std::to_string(kLiveIntervalLinuxCncInput) + " L0\n#<_pl_wait> = #5399\n";
+  const std::string chunk = n3(kLiveIntervalChunkS);
+  o << read;
+  o << "o102 while [#<_pl_wait> GT 0]\n";
+  o << "o103 if [#<_pl_wait> GT " << chunk << "]\n";
+  o << "#<_pl_wait> = " << chunk << "\n";
+  o << "o103 endif\n";
+  o << "G4 P#<_pl_wait>\n";
+  o << read;
+  o << "o102 endwhile\n";
+}
+
+// The same on a Fanuc control, inside WHILE ... DO1 (#100 the cycle, #101 the value read).
+void fanucWait(std::ostream& o, const ProbeProgram& p) {
+  if (!p.live_interval) {
+    o << "G4 X" << n3(p.gap_s) << "\n";
+    return;
+  }
+  const std::string read = "#101=#" + std::to_string(kLiveIntervalFanucVariable) + "\n";
+  const std::string chunk = n3(kLiveIntervalChunkS);
+  o << read;
+  o << "WHILE [#101 GT 0] DO2\n";
+  o << "IF [#101 GT " << chunk << "] THEN #101=" << chunk << "\n";
+  o << "G4 X#101\n";
+  o << read;
+  o << "END2\n";
+}
+
+}  // namespace
+
 std::string writeLinuxCnc(const ProbeProgram& p) {
   LinuxWriter w;
   auto& o = w.out;
   o << "(" << clean(p.title) << ")\n";
   for (const auto& h : p.header) o << "(" << clean(h) << ")\n";
+  for (const auto& h : liveIntervalHeader(p, "HAL analog input " + std::to_string(kLiveIntervalLinuxCncInput) +
+                                                 " (M66 E" + std::to_string(kLiveIntervalLinuxCncInput) +
+                                                 " L0 -> #5399)"))
+    o << "(" << clean(h) << ")\n";
   o << "G21 G90 G17 G40 G49 G80 G94\n";
   o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_b_axis) << "\n";
   o << wcs(p.work_offset) << "\n";
@@ -289,7 +348,7 @@ std::string writeLinuxCnc(const ProbeProgram& p) {
   o << "o100 while [#<_pl_cycle> LE " << p.cycles << "]\n";
   for (const auto& op : p.cycle_body) w.op(op);
   o << "o101 if [#<_pl_cycle> LT " << p.cycles << "]\n";
-  o << "G4 P" << n3(p.gap_s) << "\n";
+  linuxCncWait(o, p);
   o << "o101 endif\n";
   o << "#<_pl_cycle> = [#<_pl_cycle> + 1]\n";
   o << "o100 endwhile\n";
@@ -305,6 +364,9 @@ std::string writeFanucMacroB(const ProbeProgram& p, int program_number) {
   o << "%\n";
   o << "O" << program_number << " (" << FanucWriter::upper(clean(p.title)) << ")\n";
   for (const auto& h : p.header) o << "(" << FanucWriter::upper(clean(h)) << ")\n";
+  for (const auto& h : liveIntervalHeader(p, "common variable #" + std::to_string(kLiveIntervalFanucVariable) +
+                                                 " (written by FOCAS cnc_wrmacro)"))
+    o << "(" << FanucWriter::upper(clean(h)) << ")\n";
   o << "G21 G90 G17 G40 G49 G80 G94\n";
   o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_b_axis) << "\n";
   o << wcs(p.work_offset) << "\n";
@@ -315,7 +377,7 @@ std::string writeFanucMacroB(const ProbeProgram& p, int program_number) {
   o << "WHILE [#100 LE " << p.cycles << "] DO1\n";
   for (const auto& op : p.cycle_body) w.op(op);
   o << "IF [#100 GE " << p.cycles << "] GOTO 10\n";
-  o << "G4 X" << n3(p.gap_s) << "\n";
+  fanucWait(o, p);
   o << "N10 #100=#100+1\n";
   o << "END1\n";
   for (const auto& op : p.after_cycles) w.op(op);

@@ -74,6 +74,22 @@ TEST(SphereArtifact, NanIsRejected) {
   EXPECT_NE(m.find("sphere.diameter"), std::string::npos) << m;
 }
 
+// cycles.live_interval: absent is false (the fixed gap); a value that is not a bool is refused
+// with its line and field.
+TEST(SphereArtifact, LiveIntervalIsAnOptionalBool) {
+  EXPECT_FALSE(loadSphereArtifact(src + "/parts/sphere_artifact.yaml").live_interval);
+  std::ifstream in(src + "/parts/sphere_artifact.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), {});
+  const std::string key = "  tool_change_each_cycle: true\n";
+  ASSERT_NE(text.find(key), std::string::npos);
+  text.replace(text.find(key), key.size(), key + "  live_interval: true\n");
+  const auto a = loadSphereArtifact(writeTemp("live.yaml", text));
+  EXPECT_TRUE(a.live_interval);
+  EXPECT_DOUBLE_EQ(a.gap_s, 300.0);  // still read: the nominal schedule
+  const auto m = artifactError("  tool_change_each_cycle: true", "  tool_change_each_cycle: true\n  live_interval: 5 min");
+  EXPECT_NE(m.find("artifact.yaml:25: cycles.live_interval: expected true or false"), std::string::npos) << m;
+}
+
 TEST(Machine, ShippedMachinesLoad) {
   const auto m = loadMachine(src + "/parts/machines/nmv5000.yaml");
   EXPECT_EQ(m.dialect, Dialect::FanucMacroB);

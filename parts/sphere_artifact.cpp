@@ -69,6 +69,7 @@ SphereArtifact loadSphereArtifact(const std::string& path) {
   a.gap_s = c.quantity("gap", Dimension::Duration);
   if (a.gap_s < 0) c.fail("gap", "must not be negative");
   a.tool_change_each_cycle = c.boolean("tool_change_each_cycle");
+  a.live_interval = c.booleanOr("live_interval", false);
   c.finish();
 
   if (auto u = root.mapIfPresent("uncertainty")) {

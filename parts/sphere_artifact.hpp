@@ -29,6 +29,10 @@ struct SphereArtifact {
   int cycle_count = 0;                 // either a count ...
   double duration_s = 0;               // ... or a duration (count derived)
   double gap_s = 300;                  // end of one cycle to start of the next
+  // The wait between cycles decided outside the running program (the live TALC loop writes it:
+  // Fanuc #500, LinuxCNC analog input 0; gcode/probe_program.hpp); gap_s then only sets the
+  // nominal schedule of the plan manifest.
+  bool live_interval = false;
   bool tool_change_each_cycle = true;  // probe in and out every cycle (seed 004: 2 ATC)
   // Budget inputs (docs/uncertainty.md); NaN = not stated (listed in the budget as such).
   double radius_from_axis_u_mm = NAN;           // standard uncertainty of d/2

@@ -63,6 +63,11 @@ TestPiecePlan sphere(const parts::SphereArtifact& a, const parts::Machine& m, pa
     << printf1("  probing      %6.1f s\n", t.probing_s);
   s << "  (no acceleration; see docs/sphere-cycle.md for the comparison with 95 s)\n";
   s << "  the probing plan as QIF 3.0: " << pathIn(out_dir, kQifProbePlanFile) << "\n";
+  if (a.live_interval)
+    s << "  interval between cycles: live, read from "
+      << (linux ? "HAL analog input " + std::to_string(gcode::kLiveIntervalLinuxCncInput) + " (M66)"
+                : "#" + std::to_string(gcode::kLiveIntervalFanucVariable) + " (FOCAS cnc_wrmacro)")
+      << "; 0 runs the cycles back to back; plan.json's schedule is nominal (gap " << formatNumber(a.gap_s) << " s)\n";
   out.summary = s.str();
   out.manifest = std::move(plan.manifest);
   return out;

@@ -180,6 +180,7 @@ SpherePlan planSphereCycle(const SphereArtifact& a, const Machine& m, const Plan
   prog.has_b_axis = m.b.present;
   prog.log_file = files.log_file;
   prog.gap_s = a.gap_s;
+  prog.live_interval = a.live_interval;
 
   std::vector<gcode::Op>& body = prog.cycle_body;
   std::vector<gcode::Op> before, after;
@@ -297,12 +298,14 @@ SpherePlan planSphereCycle(const SphereArtifact& a, const Machine& m, const Plan
     body_start += T + a.gap_s;
   }
 
+  // With the live interval the gap is the plan's assumption, not what the program does: the
+  // writer adds where the wait comes from (gcode/probe_program.hpp).
   prog.header = {
       "machine: " + m.name,
       "sphere d = " + formatNumber(a.sphere_diameter_mm) + " mm at d/2 = " +
           formatNumber(a.radius_from_axis_mm) + " mm from C; tip d = " +
           formatNumber(m.probe.tip_diameter_mm) + " mm",
-      "cycles: " + std::to_string(cycles) + ", gap " + formatNumber(a.gap_s) +
+      "cycles: " + std::to_string(cycles) + (a.live_interval ? ", nominal gap " : ", gap ") + formatNumber(a.gap_s) +
           " s, estimated cycle time " + formatNumber(T, 1) + " s",
       "coordinates: G" + std::to_string(53 + prog.work_offset) +
           " zeroed = machine coordinates of the stylus-tip centre with G43",

@@ -2,8 +2,16 @@
 #include "planner/sphere_cycle.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "core/error.hpp"
+#include "parts/piece_kinds.hpp"
+#include "verify/safety.hpp"
 
 using namespace probeloop;
 using namespace probeloop::planner;
@@ -130,4 +138,114 @@ TEST(SphereCycle, TheScheduleHoldsTheCReturnAndOnlyTheToolChangesThatHappen) {
   // The first point of the first cycle comes after the probe-in change (6 s), the first of a
   // later cycle after the C return: both at cycle_start + time_in_cycle on one clock.
   EXPECT_GT(outside.manifest.points[0].time_in_cycle_s, 6.0);
+}
+
+// The live interval (cycles.live_interval): the wait between cycles is read from outside while
+// the program runs. The expected blocks are written out here by hand from the design (Fanuc
+// #500 into #101 inside DO2; LinuxCNC M66 E0 L0 into #<_pl_wait>), not taken from the writer.
+namespace {
+const std::string kFanucWait =
+    "IF [#100 GE 12] GOTO 10\n"
+    "#101=#500\n"
+    "WHILE [#101 GT 0] DO2\n"
+    "IF [#101 GT 60.000] THEN #101=60.000\n"
+    "G4 X#101\n"
+    "#101=#500\n"
+    "END2\n"
+    "N10 #100=#100+1\n"
+    "END1\n";
+const std::string kLinuxCncWait =
+    "o101 if [#<_pl_cycle> LT 12]\n"
+    "M66 E0 L0\n"
+    "#<_pl_wait> = #5399\n"
+    "o102 while [#<_pl_wait> GT 0]\n"
+    "o103 if [#<_pl_wait> GT 60.000]\n"
+    "#<_pl_wait> = 60.000\n"
+    "o103 endif\n"
+    "G4 P#<_pl_wait>\n"
+    "M66 E0 L0\n"
+    "#<_pl_wait> = #5399\n"
+    "o102 endwhile\n"
+    "o101 endif\n";
+parts::Machine linuxCncMill() { return parts::loadMachine(src + "/parts/machines/linuxcnc_rotary_mill.yaml"); }
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (auto at = text.find(what); at != std::string::npos; at = text.find(what, at + what.size())) ++n;
+  return n;
+}
+}  // namespace
+
+TEST(SphereCycle, TheLiveIntervalReplacesTheFixedDwellInBothDialects) {
+  auto a = artifact();
+  a.live_interval = true;
+  const auto fa = programText(planSphereCycle(a, machine()), parts::Dialect::FanucMacroB);
+  const auto lc = programText(planSphereCycle(a, linuxCncMill()), parts::Dialect::LinuxCnc);
+  EXPECT_EQ(count(fa, kFanucWait), 1u) << fa;
+  EXPECT_EQ(count(lc, kLinuxCncWait), 1u) << lc;
+  EXPECT_EQ(count(fa, "G4 X300.000"), 0u);  // the nominal gap is not dwelt
+  EXPECT_EQ(count(lc, "G4 P300.000"), 0u);
+  // The header says where the value comes from, that 0 runs the cycles back to back and that
+  // the schedule is nominal.
+  EXPECT_NE(fa.find("(MEASUREMENT INTERVAL: LIVE, FROM COMMON VARIABLE #500 [WRITTEN BY FOCAS CNC_WRMACRO]"),
+            std::string::npos) << fa;
+  EXPECT_NE(lc.find("(measurement interval: live, from HAL analog input 0 [M66 E0 L0 -> #5399]"), std::string::npos)
+      << lc;
+  for (const auto* t : {&fa, &lc}) {
+    EXPECT_EQ(count(*t, "back to back") + count(*t, "BACK TO BACK"), 1u);
+    EXPECT_EQ(count(*t, "nominal gap 300 s") + count(*t, "NOMINAL GAP 300 S"), 1u);
+  }
+  // The manifest's schedule stays the nominal one, with the gap.
+  const auto fixed = planSphereCycle(artifact(), machine());
+  EXPECT_EQ(planSphereCycle(a, machine()).manifest.cycle_start_s, fixed.manifest.cycle_start_s);
+  // Without the option: the fixed dwell, and nothing of the live interval.
+  const auto fa0 = programText(fixed, parts::Dialect::FanucMacroB);
+  EXPECT_EQ(count(fa0, "G4 X300.000"), 1u);
+  EXPECT_EQ(count(fa0, "#500"), 0u);
+  EXPECT_EQ(count(programText(planSphereCycle(artifact(), linuxCncMill()), parts::Dialect::LinuxCnc), "M66"), 0u);
+}
+
+// `plan` and `probeloop check` run the safety verifier on the program text: with nothing
+// writing the value (0) the wait loop is not entered, and no block of it is refused.
+TEST(SphereCycle, TheLiveProgramsPassTheSafetyVerifier) {
+  auto a = artifact();
+  a.live_interval = true;
+  const auto piece = parts::loadTestPiece(src + "/parts/sphere_artifact.yaml");
+  const auto fa = verify::checkPrograms(
+      {{"sphere_cycle.nc", programText(planSphereCycle(a, machine()), parts::Dialect::FanucMacroB)}}, machine(), piece);
+  EXPECT_TRUE(fa.safe()) << fa.findings.front().file << ":" << fa.findings.front().line << " " << fa.findings.front().what;
+  const auto lc = verify::checkPrograms(
+      {{"sphere_cycle.ngc", programText(planSphereCycle(a, linuxCncMill()), parts::Dialect::LinuxCnc)}}, linuxCncMill(),
+      piece);
+  EXPECT_TRUE(lc.safe()) << lc.findings.front().file << ":" << lc.findings.front().line << " " << lc.findings.front().what;
+}
+
+// LinuxCNC's own interpreter (rs274, linuxcnc-uspace; scripts/setup.sh installs it) runs the
+// live program to its end. Standalone it reads analog inputs as 0, so it never dwells: every
+// cycle's probe moves follow back to back, where the fixed program dwells 11 times.
+TEST(SphereCycle, Rs274RunsTheLiveLinuxCncProgram) {
+  namespace fs = std::filesystem;
+  ASSERT_EQ(std::system("command -v rs274 >/dev/null 2>&1"), 0)
+      << "LinuxCNC's rs274 is not installed (linuxcnc-uspace; run scripts/setup.sh)";
+  const fs::path dir = fs::temp_directory_path() / ("probeloop_live_rs274_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  // rs274 standalone reads tool lengths in inches: the probe's 150 mm.
+  std::ofstream(dir / "tool.tbl") << "T99 P99 Z5.905511811 D0.236220472 ;probe\n";
+  auto canon = [&](bool live) {
+    auto a = artifact();
+    a.live_interval = live;
+    std::ofstream(dir / "cycle.ngc") << programText(planSphereCycle(a, linuxCncMill()), parts::Dialect::LinuxCnc);
+    const std::string cmd = "cd '" + dir.string() + "' && rs274 -t tool.tbl -g cycle.ngc > canon.txt 2>&1";
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    std::stringstream s;
+    s << std::ifstream(dir / "canon.txt").rdbuf();
+    return s.str();
+  };
+  const std::string live = canon(true), fixed = canon(false);
+  fs::remove_all(dir);
+  EXPECT_NE(live.find("PROGRAM_END()"), std::string::npos) << live.substr(live.size() > 2000 ? live.size() - 2000 : 0);
+  EXPECT_EQ(count(live, "STRAIGHT_PROBE("), 2u * 25u * 12u);  // protected + measuring move per point
+  EXPECT_EQ(count(live, "LOG(\"PT "), 25u * 12u);
+  EXPECT_EQ(count(live, "DWELL("), 0u);
+  EXPECT_EQ(count(fixed, "DWELL(300.0000)"), 11u);
 }

@@ -352,6 +352,10 @@ class Checker : public gcode::MachineInterface, public gcode::ProbeBranching {
     return r;
   }
   void dwell(double) override { event("a dwell"); }
+  // externalVariable and analogInput keep MachineInterface's defaults on purpose: the program is
+  // checked as it runs with nothing writing the sphere cycle's live interval (Fanuc #500,
+  // LinuxCNC analog input 0), so its wait loop is not entered. Any value written would only add
+  // dwells, which move nothing; one that never drops to 0 would be an endless loop by design.
   void toolChange(int tool) override {
     event("a tool change");
     toolOf(tool);
