@@ -122,6 +122,8 @@ Subcommand addSimulateCommand(CLI::App& app) {
                    "its offsets applied and its interval read by the program (Fanuc #500, LinuxCNC analog input 0)")->check(inputFile());
   addTalcOptions(simc, a->live.talc, a->talc_inputs);
   simc->add_option("--grid-s", a->live.grid_s, "with --live: the prediction grid, s (default: the plan's cycle period)")->check(CLI::PositiveNumber);
+  simc->add_flag("--requested-only", a->live.requested_only, "with --live: feed TALC only the cycles it asks for (a dense "
+                 "program measuring for visualisation, as the thesis did: every cycle compensated and scored)");
   simc->add_option("--until-h", a->until_h, "stop the machine at this time, h (a live campaign's program may run longer)")->check(CLI::PositiveNumber);
   simc->add_option("--schedule", a->schedule, "plan manifest (plan.json): start each program at its planned time, the machine "
                    "off in between (the stepped workpiece's 3 h waits)")->check(inputFile());

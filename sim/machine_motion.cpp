@@ -16,6 +16,7 @@ namespace probeloop::sim::detail {
 
 void VirtualMachine::atLine(int line) {
   line_ = line;
+  ++lines_started_;
   if (until_s_ && t_ >= *until_s_) throw TimeLimitReached{};
 }
 

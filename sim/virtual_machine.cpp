@@ -209,10 +209,12 @@ SimulationOutputs simulatePrograms(const std::vector<ProgramSource>& programs, c
     gcode::Interpreter interp(dialect, p.file, p.text);
     if (p.start_s && *p.start_s > vm.time()) vm.machineOff(*p.start_s - vm.time());
     vm.beginProgram(p.file, last_fanuc);
+    const long lines_before = vm.linesStarted();
     try {
       const auto run = interp.run(vm);
       out.blocks += run.blocks_executed;
     } catch (const detail::TimeLimitReached&) {  // the campaign's end: the machine stops here
+      out.blocks += vm.linesStarted() - lines_before - 1;  // the blocks before the one it stopped at
       vm.endProgram();
       break;
     }

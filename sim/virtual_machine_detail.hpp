@@ -74,6 +74,11 @@ class VirtualMachine : public gcode::MachineInterface {
   // (the hall's time of day at t = 0; midnight without one), then the simulated time.
   double controllerClockS() const override { return 4 * 86400.0 + tr_.thermal.environment.start_clock_s + t_; }
   void atLine(int line) override;
+  // What the live loop wrote (sim/live_link.hpp); nothing without one.
+  std::optional<double> externalVariable(int n) const override {
+    return live_ ? live_->externalVariable(t_, n) : std::nullopt;
+  }
+  double analogInput(int n) override { return live_ ? live_->analogInput(t_, n) : 0.0; }
 
   // --- gcode::MachineInterface (machine_motion.cpp) ---------------------------------------
   void rapid(const MachinePosition& to) override;
@@ -96,6 +101,7 @@ class VirtualMachine : public gcode::MachineInterface {
 
   // --- results (virtual_machine.cpp) ------------------------------------------------------
   double time() const { return t_; }
+  long linesStarted() const { return lines_started_; }  // atLine calls so far
   std::vector<LogOutput> logs() const;
   std::string inputsText() const { return inputs_.str(); }
   const std::vector<ProbeEvent>& events() const { return events_; }
@@ -268,6 +274,7 @@ class VirtualMachine : public gcode::MachineInterface {
   bool program_fanuc_ = false;
   std::vector<ProbeEvent> events_;
   int line_ = 0;
+  long lines_started_ = 0;
   bool trace_on_ = false, trace_program_ = false;
   std::ostringstream trace_;
 };
