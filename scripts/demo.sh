@@ -70,6 +70,16 @@ probeloop model diagnose "$C/model.yaml" --part "$C/artifact.yaml" --report "$C/
   grep -v '^Wrote' | grep . | tail -1 | fold -s -w 100 | sed 's/^/   /'
 echo "-- TALC replay (seed 004 Ch. 6) on the same campaign, a 36 h calibration phase (it holds the door event at 30 h) --"
 probeloop model talc --inputs "$C/run/inputs.csv" --errors "$C/eval/errors.csv" --cp-h 36 | sed -n '5,8p' | sed 's/^/   /'
+echo "-- TALC live, closed on the virtual machine (docs/live_loop.md): the cycle paced through #500, the offsets of"
+echo "   seed 004 Eqs. 6.3-6.5 applied as the machine runs; CP 24 h, then hourly; the door at 30 h starts a No-Good phase --"
+sed 's/^  count: 12$/  duration: 72 h\n  live_interval: true/' parts/sphere_artifact.yaml > "$C/live.yaml"
+$PL plan "$C/live.yaml" --machine parts/machines/nmv5000.yaml --out "$C/live-plan" >/dev/null
+$PL campaign init "$C/live.campaign" --manifest "$C/live-plan/plan.json" >/dev/null
+$PL simulate "$C/live-plan/sphere_cycle.nc" --machine parts/machines/nmv5000.yaml --part "$C/live.yaml" \
+  --truth examples/truth_campaign.yaml --out "$C/live" --seed 1 --live "$C/live.campaign" --cp-h 24 --post-interval-h 1 \
+  --until-h 72 | tail -4 | sed 's/^/   /'
+echo "   events: $(python3 -c "import sqlite3; print('; '.join(f'{t / 3600:.1f} h {a}' for t, a in sqlite3.connect('$C/live.campaign').execute('SELECT t_s, action FROM talc_events ORDER BY seq')))")"
+echo "   dashboard: $C/live/live/dashboard.html (store: $C/live.campaign)"
 echo
 echo "== 7. the thermal test piece (seed 004 Ch. 7): plan -> 8 h on the virtual machine -> CMM and on-machine -> E with U =="
 T=$OUT/ttp
