@@ -132,6 +132,9 @@ std::string liveDashboardHtml(CampaignStore& store, const LiveLoop& loop, const 
     for (std::size_t i = 0; i < last->values.size(); ++i) page.html += td(valueU(last->values[i], last->U[i] / 2), true);
     page.html += "</tr>\n</table>\n<p class=\"note\">value \u00b1 u; U = 2 u (k = 2).</p>\n";
   }
+  if (!loop.latestDiagnosis().empty())
+    page.html += "<p class=\"verdict\">Diagnosis at the latest model update: <strong>" + esc(loop.latestDiagnosis()) +
+                 "</strong></p>\n";
   page.html += "</header>\n<div id=\"vega-errors\" class=\"errors\" role=\"alert\"></div>\n<script>" +
                std::string(kErrorHook) + "</script>\n";
 
@@ -204,11 +207,13 @@ std::string liveDashboardHtml(CampaignStore& store, const LiveLoop& loop, const 
   page.html += "</table>\n<p class=\"note\">Over the measurements after the calibration phase; P99 = Hazen percentile of "
                "|value|.</p>\n</section>\n";
 
-  page.html += "<section>\n<h2>Model versions</h2>\n<table>\n<tr>" + th("version", true) + th("time (h)", true) + th("why") + "</tr>\n";
+  page.html += "<section>\n<h2>Model versions</h2>\n<table>\n<tr>" + th("version", true) + th("time (h)", true) + th("why") +
+               th("diagnosis") + "</tr>\n";
   {
-    auto q = db.prepare("SELECT version, t_s, reason FROM models ORDER BY version");
+    auto q = db.prepare("SELECT version, t_s, reason, diagnosis FROM models ORDER BY version");
     while (q.step())
-      page.html += "<tr>" + td(std::to_string(q.integer(0)), true) + td(fixed(q.real(1) / 3600.0, 3), true) + td(q.text(2)) + "</tr>\n";
+      page.html += "<tr>" + td(std::to_string(q.integer(0)), true) + td(fixed(q.real(1) / 3600.0, 3), true) + td(q.text(2)) +
+                   td(q.text(3)) + "</tr>\n";
   }
   page.html += "</table>\n</section>\n<section>\n<h2>Events</h2>\n<table>\n<tr>" + th("time (h)", true) + th("channel") +
                th("residual", true) + th("action") + "</tr>\n";

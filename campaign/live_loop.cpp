@@ -4,6 +4,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <sstream>
 
 #include "core/csv.hpp"
 #include "core/error.hpp"
@@ -110,6 +111,8 @@ LiveLoop::LiveLoop(CampaignStore& store, const LiveOptions& o) : store_(store), 
     stored_ticks_ = static_cast<int>(q.integer(0));
     auto c = db.prepare("SELECT cycle FROM talc_measurements ORDER BY cycle");
     while (c.step()) stored_cycles_.push_back(static_cast<int>(c.integer(0)));
+    auto ch = db.prepare("SELECT input, after_steps FROM talc_input_changes ORDER BY seq");
+    while (ch.step()) changes_.push_back({ch.text(0), static_cast<int>(ch.integer(1))});
     auto e = db.prepare("SELECT COUNT(*) FROM talc_events");
     e.step();
     const auto stored_events = static_cast<std::size_t>(e.integer(0));
@@ -128,6 +131,39 @@ LiveLoop::LiveLoop(CampaignStore& store, const LiveOptions& o) : store_(store), 
 }
 
 LiveLoop::~LiveLoop() = default;
+
+void requestLiveInput(CampaignStore& store, const std::string& name) {
+  store.upgradeToLiveSchema();
+  Database& db = store.database();
+  model::InputSeries header;
+  {
+    auto h = db.prepare("SELECT header FROM input_source WHERE id = 1");
+    if (!h.step()) throw InputError(db.path(), 0, "no inputs stream ingested yet: nothing to add " + name + " from");
+    header.names = csvHeaderFields(h.text(0) + "\n");
+    header.file = db.path() + " (inputs)";
+  }
+  const model::TalcInputColumns c = model::resolveTalcInputs(header, {name});  // InputError when absent
+  std::vector<std::string> used;
+  {
+    auto q = db.prepare("SELECT json FROM talc_config WHERE id = 1");
+    if (q.step()) used = Json::parse(q.text(0)).value("inputs", std::vector<std::string>{});
+  }
+  if (used.empty())
+    for (const auto& l : model::resolveTalcInputs(header, {}).labels) used.push_back(l);
+  else
+    used = model::resolveTalcInputs(header, used).labels;
+  auto q = db.prepare("SELECT label FROM talc_input_changes");
+  while (q.step()) used.push_back(q.text(0));
+  if (std::find(used.begin(), used.end(), c.labels[0]) != used.end())
+    throw InputError(db.path(), 0, "the live loop's models already use " + c.labels[0]);
+  Transaction tx(db);
+  auto seen = db.prepare("SELECT 1 FROM talc_input_requests WHERE input = ?");
+  seen.bind(1, name);
+  if (seen.step()) throw InputError(db.path(), 0, name + " was requested already (the loop takes it at its next pass)");
+  seen.reset();
+  db.prepare("INSERT INTO talc_input_requests (input) VALUES (?)").bind(1, name).run();
+  tx.commit();
+}
 
 bool LiveLoop::started() const { return tc_ != nullptr; }
 TalcPhase LiveLoop::phase() const { return tc_ ? tc_->phase() : TalcPhase::calibration; }
@@ -226,6 +262,7 @@ bool LiveLoop::run(bool finished, bool write, LiveProgress* progress, bool log_p
     tc_ = std::make_unique<model::TalcController>(o_.talc, channels_, columns_->labels, grid_s_, t0_);
   }
   for (;;) {
+    applyInputChanges(write);
     const Measurement* m = next_meas_ < meas_.size() ? &meas_[next_meas_] : nullptr;
     if (m && !write && !std::binary_search(stored_cycles_.begin(), stored_cycles_.end(), m->cycle)) m = nullptr;
     if (m && tc_->gridIndex(m->t_s) < next_tick_) {
@@ -266,7 +303,97 @@ bool LiveLoop::run(bool finished, bool write, LiveProgress* progress, bool log_p
     ++next_tick_;
     if (progress) progress->ticks++;
   }
+  applyInputChanges(write);
   return true;
+}
+
+// Stored changes at their step count (a rebuild); in a writing run, then the requests not yet
+// applied, here and now (recorded with the step count, in a transaction of their own).
+void LiveLoop::applyInputChanges(bool write) {
+  const int steps = next_tick_ + static_cast<int>(next_meas_);
+  while (changes_applied_ < changes_.size() && changes_[changes_applied_].after_steps == steps)
+    addInput(changes_[changes_applied_++].input);
+  if (!write || changes_applied_ < changes_.size()) return;
+  Database& db = store_.database();
+  std::vector<std::string> requested;
+  {
+    auto q = db.prepare("SELECT input FROM talc_input_requests WHERE input NOT IN (SELECT input FROM talc_input_changes) "
+                        "ORDER BY seq");
+    while (q.step()) requested.push_back(q.text(0));
+  }
+  for (const auto& name : requested) {
+    Transaction tx(db);
+    addInput(name);
+    const double t = tc_->inputRows() > 0 ? tc_->gridTime(tc_->inputRows() - 1) : t0_;
+    db.prepare("INSERT INTO talc_input_changes (input, label, after_steps, t_s) VALUES (?, ?, ?, ?)")
+        .bind(1, name).bind(2, columns_->labels.back()).bind(3, steps).bind(4, t).run();
+    recordNew(true, t);
+    tx.commit();
+    changes_.push_back({name, steps});
+    ++changes_applied_;
+  }
+}
+
+void LiveLoop::addInput(const std::string& name) {
+  const model::TalcInputColumns add = model::resolveTalcInputs(inputs_, {name});
+  for (const auto& l : columns_->labels)
+    if (l == add.labels[0]) return;  // already in the model: nothing to add
+  std::vector<double> values;
+  for (int k = 0; k < tc_->inputRows(); ++k) values.push_back(model::talcInputRow(add, inputs_, tc_->gridTime(k), t0_)[0]);
+  columns_->labels.push_back(add.labels[0]);
+  columns_->column.push_back(add.column[0]);
+  columns_->absolute.push_back(add.absolute[0]);
+  columns_->relative.push_back(add.relative[0]);
+  tc_->addInput(add.labels[0], values, o_.talc.nb);
+}
+
+// Which input the models miss: every column they do not use, scored on the latest update's
+// data (the MDL criterion per channel without and with it); the one that lowers it by 20 % or
+// more on the most channels (then by the mean gain) is named with its command.
+std::string LiveLoop::diagnose() const {
+  const int kend = tc_->lastUpdateIndex();
+  if (kend < 0) return "";
+  struct Best {
+    std::string name, label;
+    int helped = 0;
+    double mean_gain = 0;
+    std::vector<double> gains;
+  };
+  std::optional<Best> best;
+  for (const auto& name : inputs_.names) {
+    if (name == "time_s") continue;
+    model::TalcInputColumns c;
+    try {
+      c = model::resolveTalcInputs(inputs_, {name});
+    } catch (const InputError&) {
+      continue;
+    }
+    if (std::find(columns_->labels.begin(), columns_->labels.end(), c.labels[0]) != columns_->labels.end()) continue;
+    std::vector<double> values;
+    for (int k = 0; k <= kend; ++k) values.push_back(model::talcInputRow(c, inputs_, tc_->gridTime(k), t0_)[0]);
+    const auto s = tc_->scoreCandidate(values, kend);
+    if (!s) continue;
+    Best b{name, c.labels[0], 0, 0, {}};
+    for (std::size_t q = 0; q < s->mdl_without.size(); ++q) {
+      const double g = s->mdl_without[q] > 0 ? 1 - s->mdl_with[q] / s->mdl_without[q] : 0;
+      b.gains.push_back(g);
+      b.helped += g >= 0.2 ? 1 : 0;
+      b.mean_gain += g / static_cast<double>(s->mdl_without.size());
+    }
+    if (b.helped > 0 && (!best || b.helped > best->helped || (b.helped == best->helped && b.mean_gain > best->mean_gain)))
+      best = b;
+  }
+  if (!best) return "no input the models do not use lowers their MDL criterion by 20 % on any channel";
+  std::ostringstream s;
+  s << "the models miss " << best->label << ": with it the MDL criterion falls";
+  bool first = true;
+  for (std::size_t q = 0; q < best->gains.size(); ++q)
+    if (best->gains[q] >= 0.2) {
+      s << (first ? " " : ", ") << static_cast<int>(std::lround(100 * best->gains[q])) << " % on " << channels_[q];
+      first = false;
+    }
+  s << "; add it: probeloop campaign add-input " << store_.database().path() << " " << best->name;
+  return s.str();
 }
 
 void LiveLoop::maybeCloseCalibration(double step_t, bool at_tick, bool write) {
@@ -397,9 +524,16 @@ void LiveLoop::recordNew(bool write, double t_s) {
           .bind(1, e.t_s).bind(2, e.channel).bind(3, e.residual).bind(4, e.action).run();
     if (isModelEvent(e.action)) {
       ++models_recorded_;
-      if (write)
-        db.prepare("INSERT INTO models (version, t_s, reason, json) VALUES (?, ?, ?, ?)")
-            .bind(1, models_recorded_).bind(2, e.t_s).bind(3, e.action).bind(4, modelsJson(*tc_).dump()).run();
+      if (write) {
+        diagnosis_ = diagnose();
+        db.prepare("INSERT INTO models (version, t_s, reason, json, diagnosis) VALUES (?, ?, ?, ?, ?)")
+            .bind(1, models_recorded_).bind(2, e.t_s).bind(3, e.action).bind(4, modelsJson(*tc_).dump())
+            .bind(5, diagnosis_).run();
+      } else {
+        auto q = db.prepare("SELECT diagnosis FROM models WHERE version = ?");
+        q.bind(1, models_recorded_);
+        if (q.step()) diagnosis_ = q.text(0);
+      }
     }
   }
   const std::string phase = model::talcPhaseName(tc_->phase());

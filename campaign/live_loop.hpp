@@ -29,6 +29,12 @@
 // - requested_only: a cycle TALC did not ask for (a dense log replayed) is stored and scored
 //   (its residual against the prediction) but not fed; then the live loop gives the replay's
 //   result (model/talc.hpp) on the same data and grid.
+// Inputs added while it runs (`campaign add-input`, after a diagnosis named one): a request
+// the loop takes at its next pass, applied between two steps (recorded with the number of
+// steps before it, so a rebuild applies it at the same place) and used from the next update.
+// At every model version the loop scores each input the models do not use (the MDL criterion
+// of each channel's WLS fit without and with it, on the update's data) and stores which one
+// it would add, with the command (the dashboard shows it).
 // Contract: the options are stored at the first run; a later run with other options is an
 // InputError naming the field (the store is not touched). Errors of the data (an input column
 // TALC needs that the stream lacks) are InputErrors before anything is written.
@@ -87,6 +93,10 @@ class LiveLoop {
   // applies at or before t; nullopt before the first.
   std::optional<std::array<double, 7>> compensationAt(double t_s) const;
 
+  // The diagnosis made at the latest model version (which input the models miss, and the
+  // command that adds it), "" before the first fit.
+  const std::string& latestDiagnosis() const { return diagnosis_; }
+
   bool started() const;
   model::TalcPhase phase() const;
   const std::vector<std::string>& channels() const { return channels_; }
@@ -112,6 +122,9 @@ class LiveLoop {
   void recordNew(bool write, double t_s);
   double issuedTime(double tk) const;
   std::optional<double> openCycleFirstPoint(bool& untimed) const;
+  void applyInputChanges(bool write);
+  void addInput(const std::string& name);
+  std::string diagnose() const;
 
   CampaignStore& store_;
   LiveOptions o_;
@@ -131,11 +144,23 @@ class LiveLoop {
   std::size_t events_recorded_ = 0;
   int models_recorded_ = 0;
   std::string phase_recorded_;
+  struct InputChange {
+    std::string input;
+    int after_steps = 0;
+  };
+  std::vector<InputChange> changes_;  // stored; applied at their step count
+  std::size_t changes_applied_ = 0;
+  std::string diagnosis_;
   // Rebuild: the steps already in the store are replayed without writing.
   int stored_ticks_ = 0;
   std::vector<int> stored_cycles_;
 };
 
 std::string liveOptionsJson(const LiveOptions& o);
+
+// `campaign add-input`: asks the live loop to add an input column to its models (taken at its
+// next pass). InputError, the store untouched, for a column the inputs stream does not have
+// (yet), or one the models already use.
+void requestLiveInput(CampaignStore& store, const std::string& name);
 
 }  // namespace probeloop::campaign

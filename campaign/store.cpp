@@ -64,7 +64,11 @@ CREATE TABLE residuals (cycle INTEGER NOT NULL REFERENCES talc_measurements, cha
                         PRIMARY KEY (cycle, channel));
 CREATE TABLE talc_events (seq INTEGER PRIMARY KEY, t_s REAL NOT NULL, channel TEXT NOT NULL, residual REAL,
                           action TEXT NOT NULL);
-CREATE TABLE models (version INTEGER PRIMARY KEY, t_s REAL NOT NULL, reason TEXT NOT NULL, json TEXT NOT NULL);
+CREATE TABLE models (version INTEGER PRIMARY KEY, t_s REAL NOT NULL, reason TEXT NOT NULL, json TEXT NOT NULL,
+                     diagnosis TEXT NOT NULL DEFAULT '');
+CREATE TABLE talc_input_requests (seq INTEGER PRIMARY KEY, input TEXT NOT NULL UNIQUE);
+CREATE TABLE talc_input_changes (seq INTEGER PRIMARY KEY, input TEXT NOT NULL UNIQUE, label TEXT NOT NULL,
+                                 after_steps INTEGER NOT NULL, t_s REAL NOT NULL);
 CREATE TABLE phases (seq INTEGER PRIMARY KEY, t_s REAL NOT NULL, phase TEXT NOT NULL);
 )sql";
 

@@ -31,7 +31,9 @@ struct CampaignArgs {
   std::string store, manifest, inputs, out = ".";
   std::vector<std::string> logs, stores;
   bool finished = false;
-  CLI::App *init = nullptr, *ingest = nullptr, *status = nullptr, *exporter = nullptr, *run = nullptr;
+  CLI::App *init = nullptr, *ingest = nullptr, *status = nullptr, *exporter = nullptr, *run = nullptr,
+           *add_input = nullptr;
+  std::string input_name;
   // run
   campaign::LiveOptions live;
   std::string talc_inputs, dashboard, controller_file;
@@ -96,6 +98,7 @@ int runLive(const CampaignArgs& a) {
     if (g_stop) break;
   }
   std::fputs(campaign::liveSummaryText(loop).c_str(), stdout);
+  if (!loop.latestDiagnosis().empty()) std::printf("diagnosis at the latest update: %s\n", loop.latestDiagnosis().c_str());
   return 0;
 }
 
@@ -212,6 +215,13 @@ int runCampaign(const CampaignArgs& a) {
     return code;
   }
   if (*a.run) return runLive(a);
+  if (*a.add_input) {
+    campaign::CampaignStore store(a.store);
+    campaign::requestLiveInput(store, a.input_name);
+    std::printf("%s: %s requested; the live loop takes it at its next pass and fits with it from its next update\n",
+                a.store.c_str(), a.input_name.c_str());
+    return 0;
+  }
   campaign::CampaignStore store(a.store);
   const std::string errors = store.exportErrorsCsv(), inputs = store.exportInputsCsv();
   if (errors.empty() && inputs.empty())
@@ -261,6 +271,10 @@ Subcommand addCampaignCommands(CLI::App& app) {
   a->run->add_flag("--requested-only", a->live.requested_only, "feed TALC only the cycles it asked for (a densely measured log replayed)");
   a->run->add_option("--dashboard", a->dashboard, "live HTML dashboard, rewritten after every pass");
   a->run->add_option("--controller-file", a->controller_file, "JSON for the controller side: wait_s before the next cycle, the compensation in effect");
+  a->add_input = group->add_subcommand("add-input", "Add an input column to the live loop's models while it runs (the "
+                                                     "dashboard's diagnosis names the one they miss)");
+  a->add_input->add_option("store", a->store, "campaign store")->required()->check(inputFile());
+  a->add_input->add_option("input", a->input_name, "a column of the inputs stream (a temperature enters as its change since the start)")->required();
   return {group, [a] { return runCampaign(*a); }};
 }
 

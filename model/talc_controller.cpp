@@ -245,6 +245,7 @@ bool TalcController::closeCalibration(int k, double cp_s, std::string& why) {
     for (int i = 0; i <= k; ++i) S_[q][static_cast<std::size_t>(i)] = y(i);
   }
   models_ = std::move(ms);
+  last_update_k_ = k;
   phase_ = TalcPhase::compensation;
   cp_end_s_ = cp_s;
   done_ = k;
@@ -255,12 +256,17 @@ bool TalcController::closeCalibration(int k, double cp_s, std::string& why) {
 }
 
 // Refit every channel on the stored series up to kend (WLS, Eq. 4.20); effective from t_effect.
-void TalcController::update(int kend, double t_effect, bool after_ng) {
+Eigen::VectorXd TalcController::updateWeights(int kend) const {
   Eigen::VectorXd w(kend + 1);
   for (int k = 0; k <= kend; ++k) {
     w(k) = measured_[static_cast<std::size_t>(k)] ? 1.0 : o_.predicted_weight;
     if (o_.weight_half_life_h > 0) w(k) *= std::exp2(-(gridTime(kend) - gridTime(k)) / (o_.weight_half_life_h * 3600.0));
   }
+  return w;
+}
+
+void TalcController::update(int kend, double t_effect, bool after_ng) {
+  const Eigen::VectorXd w = updateWeights(kend);
   const Eigen::MatrixXd u = inputMatrix(kend + 1);
   std::vector<ArxModel> next;
   for (std::size_t q = 0; q < channels_.size(); ++q) {
@@ -272,6 +278,7 @@ void TalcController::update(int kend, double t_effect, bool after_ng) {
     next.push_back(*a.model);
   }
   models_ = std::move(next);
+  last_update_k_ = kend;
   events_.push_back({t_effect, "", 0, (after_ng ? "update after NG" : "periodic update") + stability(models_)});
   (after_ng ? updates_after_ng_ : updates_periodic_)++;
 }
@@ -288,18 +295,58 @@ void TalcController::advance(int kto) {
       last_update_ = gridTime(k);
     }
     if (k >= inputRows()) throw std::logic_error("TALC: input row " + std::to_string(k) + " is not known yet");
-    Eigen::MatrixXd window(L_ + 1, static_cast<Eigen::Index>(inputs_.size()));
-    for (int i = 0; i <= L_; ++i)
-      for (std::size_t c = 0; c < inputs_.size(); ++c)
-        window(i, static_cast<Eigen::Index>(c)) = U_[static_cast<std::size_t>(k - L_ + i)][c];
     for (std::size_t q = 0; q < channels_.size(); ++q) {
-      Eigen::VectorXd past(L_);
-      for (int i = 0; i < L_; ++i) past(i) = S_[q][static_cast<std::size_t>(k - L_ + i)];
-      const double v = simulate(models_[q], window, past)(L_);
+      // A model fitted before an input was added reads the first inputs of each row only.
+      const ArxModel& m = models_[q];
+      const int Lm = m.orders.maxLag();
+      const auto r = static_cast<Eigen::Index>(m.orders.nb.size());
+      Eigen::MatrixXd window(Lm + 1, r);
+      for (int i = 0; i <= Lm; ++i)
+        for (Eigen::Index c = 0; c < r; ++c)
+          window(i, c) = U_[static_cast<std::size_t>(k - Lm + i)][static_cast<std::size_t>(c)];
+      Eigen::VectorXd past(Lm);
+      for (int i = 0; i < Lm; ++i) past(i) = S_[q][static_cast<std::size_t>(k - Lm + i)];
+      const double v = simulate(m, window, past)(Lm);
       pred_[q][static_cast<std::size_t>(k)] = S_[q][static_cast<std::size_t>(k)] = v;
     }
   }
   done_ = kto;
+}
+
+void TalcController::addInput(const std::string& label, const std::vector<double>& values, int nb) {
+  if (values.size() != U_.size()) throw std::logic_error("TALC: an added input needs a value for every known grid index");
+  if (nb < 1) throw InputError("", 0, "TALC: every input order nb must be >= 1");
+  inputs_.push_back(label);
+  orders_.nb.push_back(nb);
+  for (std::size_t k = 0; k < U_.size(); ++k) U_[k].push_back(values[k]);
+  L_ = orders_.maxLag();
+  events_.push_back({U_.empty() ? t0_ : gridTime(inputRows() - 1), "", 0, "input added: " + label + " (used from the next update)"});
+}
+
+std::optional<TalcController::CandidateScore> TalcController::scoreCandidate(const std::vector<double>& values,
+                                                                              int kend) const {
+  if (kend < 0 || static_cast<int>(values.size()) <= kend || kend >= inputRows()) return std::nullopt;
+  const Eigen::VectorXd w = updateWeights(kend);
+  Eigen::MatrixXd u = inputMatrix(kend + 1);
+  Eigen::MatrixXd uc(u.rows(), u.cols() + 1);
+  uc << u, Eigen::Map<const Eigen::VectorXd>(values.data(), kend + 1);
+  ArxOrders with = orders_;
+  with.nb.push_back(o_.nb);
+  std::vector<std::string> names = inputs_;
+  names.push_back("candidate");
+  auto mdl = [](const ArxModel& m) {
+    const double d = static_cast<double>(m.theta.size()), N = m.rows;
+    return m.sigma * m.sigma * (1 + d * std::log(N) / N);
+  };
+  CandidateScore s;
+  for (std::size_t q = 0; q < channels_.size(); ++q) {
+    const Eigen::VectorXd y = head(S_[q], kend + 1);
+    const Attempt a = tryFit(y, u, orders_, inputs_, w), b = tryFit(y, uc, with, names, w);
+    if (!a.model || !b.model) return std::nullopt;
+    s.mdl_without.push_back(mdl(*a.model));
+    s.mdl_with.push_back(mdl(*b.model));
+  }
+  return s;
 }
 
 std::vector<double> TalcController::predict(int k) {

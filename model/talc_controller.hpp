@@ -28,6 +28,7 @@
 // to k exist (std::logic_error otherwise: a driver's bug); no NaN ever leaves predict().
 #pragma once
 #include <Eigen/Dense>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -75,6 +76,22 @@ class TalcController {
   // Every channel's CP fit at grid index k succeeds (models not kept).
   bool calibrationFits(int k, std::string& why) const;
 
+  // An input added while TALC runs (the live loop's `campaign add-input`): its values at every
+  // grid index known so far; later rows carry it too. The models in use keep their inputs (the
+  // first ones of each row) until the next update, which fits with it.
+  void addInput(const std::string& label, const std::vector<double>& values, int nb);
+  const std::vector<std::string>& inputs() const { return inputs_; }
+
+  // What one more input would give each channel at the last update's data (the stored series
+  // up to grid index kend, the WLS weights of an update): Rissanen's MDL criterion
+  // sigma^2 (1 + d ln N / N) of the fit without and with it (d parameters, N rows). Empty when
+  // a fit fails (a constant or unidentifiable candidate).
+  struct CandidateScore {
+    std::vector<double> mdl_without, mdl_with;
+  };
+  std::optional<CandidateScore> scoreCandidate(const std::vector<double>& values, int kend) const;
+  int lastUpdateIndex() const { return last_update_k_; }
+
   const std::vector<TalcEvent>& events() const { return events_; }
   void addEvent(const TalcEvent& e) { events_.push_back(e); }  // a driver's own (e.g. the CP extended)
   const std::vector<std::string>& channels() const { return channels_; }
@@ -93,6 +110,7 @@ class TalcController {
   bool fitCp(int kend, std::vector<ArxModel>& out, std::string& why) const;
   Eigen::MatrixXd inputMatrix(int rows) const;
   void update(int kend, double t_effect, bool after_ng);
+  Eigen::VectorXd updateWeights(int kend) const;
   void advance(int kto);
   std::string stability(const std::vector<ArxModel>& ms) const;
   void ensureGrid(int k);
@@ -115,7 +133,7 @@ class TalcController {
   std::vector<ArxModel> models_;
   std::vector<TalcEvent> events_;
   double cp_end_s_ = 0, last_update_ = 0, next_post_ = 0, next_ng_ = 0;
-  int ng_count_ = 0, done_ = -1;
+  int ng_count_ = 0, done_ = -1, last_update_k_ = -1;
   int ng_phases_ = 0, updates_after_ng_ = 0, updates_periodic_ = 0;
 };
 

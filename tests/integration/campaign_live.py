@@ -226,4 +226,60 @@ for t in cu:
     check(f"table {t}: the killed, piecewise run = the uninterrupted run", cu[t] == ck.get(t),
           f"{len(cu[t])} vs {len(ck.get(t, []))} rows; first difference: " +
           str(next(((a, b) for a, b in zip(cu[t], ck.get(t, [])) if a != b), None)))
+
+# 4. An input the models miss, named at an update and added while the loop runs: a loop that
+#    starts with the hall temperature only.
+D = f"{W}/d.campaign"
+run("campaign", "init", D, "--manifest", f"{W}/plan/plan.json")
+os.makedirs(f"{W}/feed-d", exist_ok=True)
+DLOG, DIN = f"{W}/feed-d/dprnt.txt", f"{W}/feed-d/inputs.csv"
+cut = next(i for i, e in enumerate(events) if e[0] > 10 * 3600)  # the first 10 h
+open(DLOG, "w").write("".join(e[3] for e in events[:cut] if e[2] == "log"))
+open(DIN, "w").write("".join(e[3] for e in events[:cut] if e[2] == "in"))
+DTALC = ["--cp-h", "6", "--post-interval-h", "1", "--model-inputs", "T_env_C", "--grid-s", grid]
+p = run("campaign", "run", D, "--log", DLOG, "--inputs", DIN, *DTALC)
+check("run on the first 10 h (CP 6 h, T_env_C only)", p.returncode == 0, p.stderr)
+m = re.search(r"the models miss (\S+) - start: .*; add it: (probeloop campaign add-input \S+ \S+)", p.stdout)
+# The truth heats the C axis (EY, EZ, EA, EC) and, through it, the table (EX, EB, the artifact's
+# growth: ER): either sensor is an input the hall temperature alone cannot replace.
+check("the diagnosis names a temperature of the truth's heated nodes, with the command",
+      m and m[1] in ("T_caxis_C", "T_table_C"), p.stdout[-800:])
+affected = re.findall(r"\d+ % on (\w+)", p.stdout.split("the models miss")[1]) if m else []
+if m:
+    cmd = m[2].split()
+    p = subprocess.run([PL] + cmd[1:], capture_output=True, text=True)
+    check("the printed command runs", p.returncode == 0, p.stderr)
+    p = subprocess.run([PL] + cmd[1:], capture_output=True, text=True)
+    check("asked twice: refused", p.returncode == 1 and "requested already" in p.stderr, p.stderr)
+p = run("campaign", "add-input", D, "T_nope")
+check("an input the stream does not have: refused", p.returncode == 1 and "T_nope" in p.stderr, p.stderr)
+open(DLOG, "a").write("".join(e[3] for e in events[cut:] if e[2] == "log"))
+open(DIN, "a").write("".join(e[3] for e in events[cut:] if e[2] == "in"))
+p = run("campaign", "run", D, "--log", DLOG, "--inputs", DIN, "--finished", *DTALC)
+check("run to the end", p.returncode == 0, p.stderr)
+p2 = run("campaign", "run", D, "--log", DLOG, "--inputs", DIN, "--finished", *DTALC)
+check("a later run rebuilds the state with the input added where it was", p2.returncode == 0, p2.stderr)
+db = sqlite3.connect(D)
+added = db.execute("SELECT t_s FROM talc_input_changes").fetchone()
+updates = [t for (t,) in db.execute("SELECT t_s FROM talc_events WHERE action LIKE '%update%' ORDER BY seq")]
+used = next((t for t in updates if added and t > added[0]), None)
+check("the input is taken at the next pass and used from the next update", added and used, f"{added} {updates}")
+
+
+def p99(values):
+    v = sorted(abs(x) for x in values)
+    h = 0.99 * (len(v) + 1) - 1
+    i = min(max(int(h), 0), len(v) - 1)
+    return v[i] if i + 1 >= len(v) else v[i] + (h - i) * (v[i + 1] - v[i])
+
+
+if used:
+    for ch in affected:
+        rows = db.execute("SELECT m.t_s, r.residual FROM residuals r JOIN talc_measurements m USING (cycle) "
+                          "WHERE r.channel = ? AND r.residual IS NOT NULL", (ch,)).fetchall()
+        before = [r for t, r in rows if t <= used]
+        after = [r for t, r in rows if t > used]
+        check(f"{ch}: the compensated P99 falls after that update ({p99(before):.2f} -> {p99(after):.2f}, "
+              f"{len(before)} and {len(after)} measurements)", before and after and p99(after) < p99(before), "")
+db.close()
 check.finish()
