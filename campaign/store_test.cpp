@@ -239,7 +239,7 @@ TEST_F(Fixture, AVersion1StoreIsReadAndGainsTheLiveTablesWhenTheLiveLoopAsks) {
     sqlite3* db = nullptr;
     ASSERT_EQ(sqlite3_open(store_path.c_str(), &db), SQLITE_OK);
     for (const char* t : {"talc_config", "predictions", "talc_ticks", "residuals", "talc_measurements", "talc_events",
-                          "models", "phases"})
+                          "models", "phases", "talc_input_requests", "talc_input_changes"})
       ASSERT_EQ(sqlite3_exec(db, (std::string("DROP TABLE ") + t).c_str(), nullptr, nullptr, nullptr), SQLITE_OK) << t;
     ASSERT_EQ(sqlite3_exec(db, "PRAGMA user_version = 1; UPDATE meta SET value = '1' WHERE key = 'schema_version'",
                            nullptr, nullptr, nullptr), SQLITE_OK);
