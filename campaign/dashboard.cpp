@@ -115,18 +115,29 @@ std::string liveDashboardHtml(CampaignStore& store, const LiveLoop& loop, const 
   Database& db = store.database();
   const StoreStatus s = store.status();
   Page page;
-  page.html += "<header>\n<h1>Live TALC loop: " + esc(s.machine) + "</h1>\n<p>Store " + esc(s.path) + "; plan " +
-               esc(s.manifest_file) + ". Phase now: <strong>" + esc(model::talcPhaseName(loop.phase())) +
-               "</strong>.</p>\n";
+  std::string plan_file;
   {
+    auto q = db.prepare("SELECT file FROM manifest WHERE id = 1");
+    if (q.step()) plan_file = q.text(0);
+  }
+  page.html += "<header>\n<h1>Live TALC loop: " + esc(s.machine) + "</h1>\n<p>Store " + esc(s.path) + "; plan " +
+               esc(plan_file) + ". Phase now: <strong>" + esc(model::talcPhaseName(loop.phase())) + "</strong>.</p>\n";
+  {
+    // The options as "name value" pairs, so that the line wraps.
     auto q = db.prepare("SELECT json FROM talc_config WHERE id = 1");
-    if (q.step()) page.html += "<p class=\"note\">TALC options: <code>" + esc(q.text(0)) + "</code></p>\n";
+    if (q.step()) {
+      std::string options;
+      const json o = json::parse(q.text(0));
+      for (const auto& [k, v] : o.items())
+        if (!(v.is_array() && v.empty())) options += (options.empty() ? "" : ", ") + k + " " + v.dump();
+      page.html += "<p class=\"note\">TALC options: " + esc(options) + "</p>\n";
+    }
   }
   const CycleStatus* last = nullptr;
   for (const auto& c : s.cycles)
     if (c.status != "incomplete") last = &c;
   if (last) {
-    page.html += "<table>\n<tr>" + th("latest cycle") + th("time (h)", true);
+    page.html += "<table>\n<tr>" + th("latest cycle (as measured)") + th("time (h)", true);
     for (const char* n : geometry::LocationErrors::names()) page.html += th(n, true);
     page.html += "</tr>\n<tr>" + td(std::to_string(last->cycle)) + td(fixed(last->time_s / 3600.0, 3), true);
     for (std::size_t i = 0; i < last->values.size(); ++i) page.html += td(valueU(last->values[i], last->U[i] / 2), true);

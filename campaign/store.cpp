@@ -179,6 +179,10 @@ void CampaignStore::create(const std::string& path, const std::string& manifest_
   std::filesystem::remove(tmp);
   if (std::filesystem::exists(path))
     throw InputError(path, 0, "already exists: a campaign store is created once (remove it first to start over)");
+  // A write-ahead log left by a store that was deleted without it belongs to that store:
+  // SQLite would replay it into the new one (a "malformed" store at the first open).
+  std::filesystem::remove(path + "-wal");
+  std::filesystem::remove(path + "-shm");
   {
     Database db(tmp, Database::Mode::Create);
     db.exec("PRAGMA journal_mode = DELETE");
