@@ -158,8 +158,8 @@ std::string liveDashboardHtml(CampaignStore& store, const LiveLoop& loop, const 
   json bands = json::array();
   for (const auto& b : phaseBands(db, end_s)) bands.push_back({{"from_s", b.from_s}, {"to_s", b.to_s}, {"phase", b.phase}});
 
-  std::map<int, double> time_of;
-  for (const auto& c : s.cycles) time_of[c.cycle] = c.time_s;
+  std::map<int, const CycleStatus*> cycle_of;  // a measurement's U
+  for (const auto& c : s.cycles) cycle_of[c.cycle] = &c;
   const auto& names = geometry::LocationErrors::names();
   std::vector<double> uc_p99, c_p99;
   for (std::size_t q = 0; q < loop.channels().size(); ++q) {
@@ -168,9 +168,8 @@ std::string liveDashboardHtml(CampaignStore& store, const LiveLoop& loop, const 
     json measured = json::array();
     std::vector<double> uc, cc;
     for (const auto& m : loop.measurements()) {
-      double U = 0;
-      for (const auto& c : s.cycles)
-        if (c.cycle == m.cycle && idx < c.U.size()) U = c.U[idx];
+      const auto it = cycle_of.find(m.cycle);
+      const double U = it != cycle_of.end() && idx < it->second->U.size() ? it->second->U[idx] : 0.0;
       json row = {{"t_s", m.t_s}, {"cycle", m.cycle}, {"uncompensated", m.uncompensated[q]}, {"U", U}};
       if (m.scored(loop.offsetsApplied())) {
         // With the offsets applied the cycle measured the compensated error itself.

@@ -17,6 +17,7 @@ import csv, os, random, re, shutil, signal, sqlite3, subprocess, sys, tempfile, 
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks  # noqa: E402
+from store_content import store_content  # noqa: E402
 
 PL = os.environ["PROBELOOP"]
 SRC = os.environ["PROBELOOP_SOURCE_DIR"]
@@ -97,17 +98,7 @@ def grow(store, folder, seed, kills=0):
 
 
 def content(store):
-    """Every table's rows, in key order (the store's content, whatever its pages)."""
-    db = sqlite3.connect(f"file:{store}?mode=ro", uri=True)
-    tables = [r[0] for r in db.execute("SELECT name FROM sqlite_master WHERE type = 'table' ORDER BY name")]
-    out = {}
-    for t in tables:
-        rows = db.execute(f"SELECT * FROM {t} ORDER BY 1, 2").fetchall() if t != "meta" else db.execute(
-            "SELECT * FROM meta ORDER BY key").fetchall()
-        # Paths differ between the two runs' folders: compare them by name.
-        out[t] = [tuple(os.path.basename(v) if isinstance(v, str) and v.startswith(W) else v for v in r) for r in rows]
-    db.close()
-    return out
+    return store_content(store, W)
 
 
 def rows(path):

@@ -24,6 +24,7 @@ import os, re, sqlite3, subprocess, sys, tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks  # noqa: E402
+from store_content import store_content  # noqa: E402
 from html_render import check as render_check  # noqa: E402
 
 PL = os.environ["PROBELOOP"]
@@ -132,14 +133,7 @@ check("two runs: byte-identical logs", open(f"{W}/a/dprnt.txt", "rb").read() == 
 
 
 def content(store):
-    d = sqlite3.connect(f"file:{store}?mode=ro", uri=True)
-    out = {}
-    for (t,) in d.execute("SELECT name FROM sqlite_master WHERE type = 'table' ORDER BY name"):
-        if t in ("log_sources", "input_source"):
-            continue
-        out[t] = d.execute(f"SELECT * FROM {t} ORDER BY 1, 2").fetchall()
-    d.close()
-    return out
+    return store_content(store, skip=("log_sources", "input_source"))
 
 
 ca, cb = content(A), content(B)

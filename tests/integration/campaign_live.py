@@ -19,6 +19,7 @@ import csv, os, random, re, signal, sqlite3, subprocess, sys, tempfile, time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks  # noqa: E402
+from store_content import store_content  # noqa: E402
 from html_render import check as render_check  # noqa: E402
 
 PL = os.environ["PROBELOOP"]
@@ -50,16 +51,7 @@ TALC = ["--cp-h", "6", "--post-interval-h", "1", "--ng-interval-min", "15", "--n
 
 
 def content(store):
-    """Every table's rows, in key order; paths by their base name."""
-    db = sqlite3.connect(f"file:{store}?mode=ro", uri=True)
-    tables = [r[0] for r in db.execute("SELECT name FROM sqlite_master WHERE type = 'table' ORDER BY name")]
-    out = {}
-    for t in tables:
-        rows = db.execute(f"SELECT * FROM {t} ORDER BY 1, 2").fetchall() if t != "meta" else db.execute(
-            "SELECT * FROM meta ORDER BY key").fetchall()
-        out[t] = [tuple(os.path.basename(v) if isinstance(v, str) and v.startswith(W) else v for v in r) for r in rows]
-    db.close()
-    return out
+    return store_content(store, W)
 
 
 # 1. The dense log replayed with --requested-only = the offline replay on the same data.
