@@ -347,7 +347,7 @@ struct LiveMachine : Recorder {
   }
   double analogInput(int n) override {
     inputs_read.push_back(n);
-    return n == 0 ? remaining() : 0.0;
+    return n == 0 ? remaining() : n == 1 ? 1000.0 + t_s : 0.0;  // input 1: a clock
   }
 };
 
@@ -395,8 +395,13 @@ TEST(Interpreter, TheLiveIntervalIsReadFromOutsideInBothDialects) {
   EXPECT_TRUE(linuxcnc.run(lc).ended);
   EXPECT_EQ(dwellsAfterProbes(lc), want);
   EXPECT_EQ(lc.log_lines.size(), 3u);
-  EXPECT_EQ(lc.inputs_read, std::vector<int>(1 + 3 + 1, 0));
-  EXPECT_EQ(linuxcnc.parameter(5399), 0.0);
+  // The clock (input 1) after each probe move, the wait (input 0) once before each wait loop and
+  // after each dwell; the clock is the log line's eighth field.
+  EXPECT_EQ(lc.inputs_read, (std::vector<int>{1, 0, 0, 0, 0, 1, 0, 1}));
+  ASSERT_EQ(lc.log_lines.size(), 3u);
+  EXPECT_NE(lc.log_lines[0].find(" 1000.000000"), std::string::npos) << lc.log_lines[0];
+  EXPECT_NE(lc.log_lines[1].find(" 1150.000000"), std::string::npos) << lc.log_lines[1];
+  EXPECT_EQ(linuxcnc.parameter(5399), 1150.0);  // the last read: the third point's clock
 
   // Nothing writing the value (a machine without a live loop): the cycles run back to back.
   for (const auto d : {ProgramDialect::FanucMacroB, ProgramDialect::LinuxCnc}) {

@@ -57,10 +57,11 @@ std::vector<LoggedProbePoint> parseProbeLog(const std::string& text, const std::
       if (!start) start = s;
       continue;
     }
-    if (tok[0] != "PT" || (tok.size() != 7 && tok.size() != 9)) {
+    if (tok[0] != "PT" || tok.size() < 7 || tok.size() > 9) {
       throw InputError(file, n,
                        "unrecognised log line '" + line +
-                           "'; expected 'PT <cycle> <position> <point> <x> <y> <z> [<date> <time>]' or 'START <date> <time>'");
+                           "'; expected 'PT <cycle> <position> <point> <x> <y> <z> [<date> <time> | <clock s>]' or "
+                           "'START <date> <time>'");
     }
     double v[6];
     for (int i = 0; i < 6; ++i) {
@@ -81,6 +82,12 @@ std::vector<LoggedProbePoint> parseProbeLog(const std::string& text, const std::
     p.point = static_cast<int>(v[2]);
     p.tip_mm = Eigen::Vector3d(v[3], v[4], v[5]);
     if (tok.size() == 9 && start) p.time_s = clockSeconds(tok[7], tok[8], file, n) - *start;
+    if (tok.size() == 8) {  // LinuxCNC: the inputs logger's clock from analog input 1 (gcode/probe_program.hpp)
+      double t = 0;
+      if (!parseFiniteNumber(tok[7], t) || t < 0)
+        throw InputError(file, n, "field 8 '" + tok[7] + "' (the clock, s) is not a finite number >= 0");
+      p.time_s = t;
+    }
     out.push_back(p);
   }
   return out;

@@ -4,7 +4,9 @@
 // "<date YYYYMMDD> <time HHMMSS>" (#3011, #3012), to each PT line and writes
 // "START <date> <time>" when each program starts: a point's time is its clock minus the log's
 // first START (the session's start), to the second. LinuxCNC's LOG cannot read a clock: its
-// points have no time. Blank lines and '%' are skipped; any other line is an InputError with
+// points have no time, unless the program logs one as an eighth field (a live-interval program
+// reads HAL analog input 1, the inputs logger's clock: gcode/probe_program.hpp); that value is
+// the point's time as it stands. Blank lines and '%' are skipped; any other line is an InputError with
 // file:line, so a wrong file is never half-read.
 #pragma once
 #include <Eigen/Dense>

@@ -59,3 +59,21 @@ TEST(ProbeLog, FanucClockGivesEachPointItsTimeSinceTheFirstStart) {
     EXPECT_NE(std::string(e.what()).find("e.txt:1: clock '20261301 000000'"), std::string::npos) << e.what();
   }
 }
+
+// A live LinuxCNC program logs the inputs logger's clock (analog input 1) as an eighth field:
+// that is the point's time as it stands (no START); a negative or non-finite clock is refused.
+TEST(ProbeLog, LinuxCncClockFieldIsThePointsTime) {
+  const auto p = parseProbeLog("PT 1.000000 1 1 -142.009000 0.000000 75.000000 7212.500000\n"
+                               "PT 1.000000 1 2 -160.000000 17.991000 75.000000 7230.250000\n", "live.log");
+  ASSERT_EQ(p.size(), 2u);
+  EXPECT_DOUBLE_EQ(*p[0].time_s, 7212.5);
+  EXPECT_DOUBLE_EQ(*p[1].time_s, 7230.25);
+  for (const char* bad : {"PT 1 1 1 0 0 0 -1\n", "PT 1 1 1 0 0 0 inf\n", "PT 1 1 1 0 0 0 x\n"}) {
+    try {
+      parseProbeLog(bad, "g.log");
+      FAIL() << bad;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("g.log:1: field 8"), std::string::npos) << e.what();
+    }
+  }
+}

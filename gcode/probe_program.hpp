@@ -15,6 +15,12 @@
 // #101; LinuxCNC reads HAL analog input 0 with M66 E0 L0 (#5399) into #<_pl_wait>. The writer
 // decides when the next cycle is due: it counts the value down or sets it to 0. Nothing
 // writing it (0) runs the cycles back to back.
+//
+// A live loop orders the points by their time, and LinuxCNC's LOG has no clock: with
+// `live_interval` the LinuxCNC program also reads HAL analog input 1 (M66 E1 L0) after every
+// probing move and logs it as an eighth field, "PT <cycle> <position> <point> <x> <y> <z> <t>":
+// the seconds of the clock the inputs logger stamps its samples with (the same time base as
+// the inputs' time_s). Fanuc logs its own clock (#3011, #3012) in every program.
 #pragma once
 #include <string>
 #include <vector>
@@ -28,6 +34,7 @@ namespace probeloop::gcode {
 // dwell as the dwell starts, buffering macro statements: then one chunk late).
 inline constexpr int kLiveIntervalFanucVariable = 500;   // read into #101 (#100 counts cycles)
 inline constexpr int kLiveIntervalLinuxCncInput = 0;     // M66 E0 L0 -> #5399 -> #<_pl_wait>
+inline constexpr int kLiveClockLinuxCncInput = 1;        // M66 E1 L0 -> #5399, logged with each point
 inline constexpr double kLiveIntervalChunkS = 60.0;
 
 struct ProbeProgram {

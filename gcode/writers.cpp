@@ -84,6 +84,7 @@ struct LinuxWriter {
   int label = 200;
   std::string check_hint = "check the artifact position";  // what the ABORT message tells the operator
   std::vector<std::pair<int, std::string>> loops;  // open o-while: label, parameter name
+  bool log_clock = false;  // each point's clock from analog input 1 (probe_program.hpp)
 
   void op(const Op& o) {
     std::visit(Overloaded{
@@ -104,8 +105,9 @@ struct LinuxWriter {
           // G38.2 raises "probe move finished without contact" itself: the program stops
           // and no point is logged.
           out << "G38.2" << xyz(m.x, m.y, m.z) << " F" << n3(m.feed_mm_per_min) << "\n";
+          if (log_clock) out << "M66 E" << kLiveClockLinuxCncInput << " L0\n";  // the clock, probe_program.hpp
           out << "(LOG,PT #<_pl_cycle> " << m.position << " " << m.point
-              << " #5061 #5062 #5063)\n";
+              << " #5061 #5062 #5063" << (log_clock ? " #5399" : "") << ")\n";
         },
         [&](const Dwell& d) { out << "G4 P" << n3(d.seconds) << "\n"; },
         [&](const RotateB& r) { out << rotateBLine(r); },
@@ -339,6 +341,11 @@ std::string writeLinuxCnc(const ProbeProgram& p) {
                                                  " (M66 E" + std::to_string(kLiveIntervalLinuxCncInput) +
                                                  " L0 -> #5399)"))
     o << "(" << clean(h) << ")\n";
+  if (p.live_interval) {
+    w.log_clock = true;
+    o << "(point times: HAL analog input " << kLiveClockLinuxCncInput << " [M66 E" << kLiveClockLinuxCncInput
+      << " L0 -> #5399] after each probing move, logged as the 8th field: the inputs logger's clock in s)\n";
+  }
   o << "G21 G90 G17 G40 G49 G80 G94\n";
   o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_b_axis) << "\n";
   o << wcs(p.work_offset) << "\n";

@@ -205,6 +205,22 @@ TEST(SphereCycle, TheLiveIntervalReplacesTheFixedDwellInBothDialects) {
   EXPECT_EQ(count(programText(planSphereCycle(artifact(), linuxCncMill()), parts::Dialect::LinuxCnc), "M66"), 0u);
 }
 
+// LinuxCNC's LOG has no clock: the live program reads HAL analog input 1 after every probing
+// move and logs it as the eighth field; the fixed program logs the six fields only.
+TEST(SphereCycle, TheLiveLinuxCncProgramLogsTheClockOfAnalogInputOneWithEveryPoint) {
+  auto a = artifact();
+  a.live_interval = true;
+  const auto lc = programText(planSphereCycle(a, linuxCncMill()), parts::Dialect::LinuxCnc);
+  const std::size_t probes = count(lc, "G38.2 ");
+  EXPECT_EQ(probes, 25u);
+  EXPECT_EQ(count(lc, "\nM66 E1 L0\n(LOG,PT #<_pl_cycle> "), probes) << lc;
+  EXPECT_EQ(count(lc, " #5061 #5062 #5063 #5399)\n"), probes);
+  EXPECT_NE(lc.find("(point times: HAL analog input 1"), std::string::npos);
+  const auto fixed = programText(planSphereCycle(artifact(), linuxCncMill()), parts::Dialect::LinuxCnc);
+  EXPECT_EQ(count(fixed, " #5061 #5062 #5063)\n"), 25u);
+  EXPECT_EQ(count(fixed, "#5399"), 0u);
+}
+
 // `plan` and `probeloop check` run the safety verifier on the program text: with nothing
 // writing the value (0) the wait loop is not entered, and no block of it is refused.
 TEST(SphereCycle, TheLiveProgramsPassTheSafetyVerifier) {

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "gcode/interpreter.hpp"
+#include "gcode/probe_program.hpp"
 #include "sim/machine_truth.hpp"
 #include "sim/material_removal.hpp"
 #include "sim/piece_truth.hpp"
@@ -78,7 +79,12 @@ class VirtualMachine : public gcode::MachineInterface {
   std::optional<double> externalVariable(int n) const override {
     return live_ ? live_->externalVariable(t_, n) : std::nullopt;
   }
-  double analogInput(int n) override { return live_ ? live_->analogInput(t_, n) : 0.0; }
+  // Analog input 1 carries the machine's clock (the inputs' time_s), as a live-interval LinuxCNC
+  // program expects (gcode/probe_program.hpp); the others come from the live loop, or read 0.
+  double analogInput(int n) override {
+    if (n == gcode::kLiveClockLinuxCncInput) return t_;
+    return live_ ? live_->analogInput(t_, n) : 0.0;
+  }
 
   // --- gcode::MachineInterface (machine_motion.cpp) ---------------------------------------
   void rapid(const MachinePosition& to) override;
