@@ -58,7 +58,9 @@ void writeControllerFile(const std::string& path, const campaign::LiveLoop& loop
   } else {
     j["compensation"] = nullptr;
   }
-  writeFileAtomic(path, j.dump(1) + "\n");
+  // Live: the controller side reads it while the loop runs, so it cannot wait for the command's
+  // commit (core/atomic_file.hpp).
+  writeLiveFileAtomic(path, j.dump(1) + "\n");
 }
 
 int runLive(const CampaignArgs& a) {
@@ -89,7 +91,7 @@ int runLive(const CampaignArgs& a) {
     const auto s = store.status();
     double now = s.inputs_last_time_s;
     for (const auto& c : s.cycles) now = std::max(now, c.time_s);
-    if (!a.dashboard.empty()) writeFileAtomic(a.dashboard, campaign::liveDashboardHtml(store, loop, report::defaultVegaPath()));
+    if (!a.dashboard.empty()) writeLiveFileAtomic(a.dashboard, campaign::liveDashboardHtml(store, loop, report::defaultVegaPath()));
     if (!a.controller_file.empty()) writeControllerFile(a.controller_file, loop, now);
     if (!a.follow || g_stop) break;
     idle_s = added > 0 || p.ticks > 0 || p.measurements > 0 ? 0 : idle_s + a.poll_s;

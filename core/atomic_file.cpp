@@ -104,11 +104,13 @@ void removeTemporaryFileOnInterrupt() {
   ::signal(SIGPIPE, SIG_IGN);
 }
 
-void writeFileAtomic(const std::string& path, const std::string& content) {
+namespace {
+
+// What the rename would fail on is refused before anything is staged or renamed: a commit
+// then cannot stop half-way over a folder in an output's place.
+void prepareTarget(const std::string& path) {
   namespace fs = std::filesystem;
   const fs::path target(path);
-  // What the rename would fail on is refused now, before anything is staged or renamed: a
-  // commit then cannot stop half-way over a folder in an output's place.
   std::error_code ec;
   const auto status = fs::symlink_status(target, ec);
   if (!ec && fs::is_directory(status)) throw InputError(path, 0, "cannot write: a folder of that name is in the way");
@@ -116,6 +118,26 @@ void writeFileAtomic(const std::string& path, const std::string& content) {
     fs::create_directories(target.parent_path(), ec);
     if (ec) throw InputError(path, 0, "cannot create its folder: " + ec.message());
   }
+}
+
+void replaceNow(const std::string& path, const std::string& content) {
+  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+  const int before = g_slots;
+  registerTemporary(tmp);
+  try {
+    writeTemporary(path, tmp, content);
+    renameIntoPlace(path, tmp);
+  } catch (...) {
+    forgetTemporaries(before);
+    throw;
+  }
+  forgetTemporaries(before);
+}
+
+}  // namespace
+
+void writeFileAtomic(const std::string& path, const std::string& content) {
+  prepareTarget(path);
   if (g_batch_open) {
     // The same output written twice in one command: the later content wins, one temporary.
     const std::string k = key(path);
@@ -130,17 +152,12 @@ void writeFileAtomic(const std::string& path, const std::string& content) {
     writeTemporary(path, tmp, content);
     return;
   }
-  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-  const int before = g_slots;
-  registerTemporary(tmp);
-  try {
-    writeTemporary(path, tmp, content);
-    renameIntoPlace(path, tmp);
-  } catch (...) {
-    forgetTemporaries(before);
-    throw;
-  }
-  forgetTemporaries(before);
+  replaceNow(path, content);
+}
+
+void writeLiveFileAtomic(const std::string& path, const std::string& content) {
+  prepareTarget(path);
+  replaceNow(path, content);
 }
 
 OutputBatch::OutputBatch() {

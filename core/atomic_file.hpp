@@ -19,6 +19,11 @@ namespace probeloop {
 
 void writeFileAtomic(const std::string& path, const std::string& content);
 
+// The same, replaced at once even while a batch is open: a live output that another program
+// reads while the command runs (campaign run --follow's controller file and dashboard, rewritten
+// after every pass). It is not part of the batch: an error later does not take it back.
+void writeLiveFileAtomic(const std::string& path, const std::string& content);
+
 // SIGINT / SIGTERM / SIGHUP while a file is being written remove its temporary file (with a
 // batch open, every pending one) before the process ends with the signal's usual status (128 +
 // signal); SIGPIPE is ignored (a closed stdout must not stop a command before its commit).

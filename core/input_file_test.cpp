@@ -209,5 +209,29 @@ TEST_F(InputFile, ABatchCommitsAllOutputsOrNone) {
   EXPECT_THROW({ OutputBatch one; OutputBatch two; }, std::logic_error);
 }
 
+// campaign run --follow rewrites its controller file after every pass for another program to
+// read (tools/linuxcnc_sim/live_offsets.py): a live write is in place at once, inside a batch,
+// and stays when the batch is dropped; it leaves no temporary.
+TEST_F(InputFile, ALiveWriteIsInPlaceAtOnceEvenInsideABatch) {
+  const std::string live = path("out/controller.json"), other = path("out/dashboard.csv");
+  {
+    OutputBatch batch;
+    writeLiveFileAtomic(live, "pass 1");
+    writeFileAtomic(other, "batched");
+    std::ifstream in(live);
+    EXPECT_EQ(std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>()), "pass 1");
+    EXPECT_FALSE(fs::exists(other));
+    writeLiveFileAtomic(live, "pass 2");
+    // no commit
+  }
+  EXPECT_EQ(readFile(live), "pass 2");
+  EXPECT_FALSE(fs::exists(other));
+  std::size_t files = 0;
+  for (const auto& e : fs::directory_iterator(path("out"))) files += e.is_regular_file();
+  EXPECT_EQ(files, 1u);
+  fs::create_directories(path("out/in_the_way.json"));
+  EXPECT_THROW(writeLiveFileAtomic(path("out/in_the_way.json"), "x"), InputError);
+}
+
 }  // namespace
 }  // namespace probeloop
