@@ -29,7 +29,6 @@ Needs $PROBELOOP and $PROBELOOP_SOURCE_DIR. LC_SAFETY_KEEP=1 keeps the work fold
 import json
 import os
 import re
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -38,26 +37,15 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks  # noqa: E402
 import unsafe_edits as ue  # noqa: E402
+from linuxcnc_common import SRC, SYS_PY, TOOLS, finish_run, skip_without_linuxcnc  # noqa: E402
 
-SRC = os.environ["PROBELOOP_SOURCE_DIR"]
 PL = os.environ["PROBELOOP"]
-TOOLS = os.path.join(SRC, "tools", "linuxcnc_sim")
-SYS_PY = "/usr/bin/python3"
 MACHINE = os.path.join(SRC, "parts", "machines", "linuxcnc_rotary_mill.yaml")
 PART = os.path.join(SRC, "parts", "sphere_artifact.yaml")
 MOTION_TYPES = {0: "idle", 1: "rapid", 2: "feed", 3: "arc", 4: "tool change", 5: "probing", 6: "indexing"}
 
 
-def skip(why):
-    print("SKIP linuxcnc_safety: " + why)
-    sys.exit(77)
-
-
-if not shutil.which("linuxcnc", path="/usr/sbin:/usr/bin:/sbin:/bin"):
-    skip("LinuxCNC is not installed (Debian: apt-get install linuxcnc-uspace)")
-if not os.path.exists(SYS_PY) or subprocess.run([SYS_PY, "-c", "import hal, linuxcnc, yaml"],
-                                                capture_output=True).returncode != 0:
-    skip("/usr/bin/python3 cannot import hal, linuxcnc and yaml (linuxcnc-uspace, python3-yaml)")
+skip_without_linuxcnc("linuxcnc_safety")
 
 # What LinuxCNC does with each program, as measured (docs/linuxcnc.md): ran = it ran to its end without an
 # error message; error = a regex its error message(s) must match (None: none); intrusion = the stylus tip went
@@ -104,12 +92,6 @@ def shortened(lines, finding_line, start_xy):
     assert lines[1].startswith("(") and lines[2].startswith("("), lines[1:3]
     lines[1], lines[2] = "G53 G0 Z500.0000", f"G53 G0 X{start_xy[0]} Y{start_xy[1]} C0"
     return lines[:cut + 1] + lines[end:]
-
-
-def linuxcnc_processes():
-    ps = subprocess.run(["ps", "-eo", "pid=,stat=,comm="], capture_output=True, text=True).stdout.splitlines()
-    return [row.strip() for row in ps if len(row.split()) == 3 and not row.split()[1].startswith("Z")
-            and row.split()[2] in ("rtapi_app", "milltask", "linuxcncsvr", "io", "halcmd", "linuxcnc")]
 
 
 check = Checks()
@@ -259,13 +241,5 @@ try:
     json.dump(rows, open(f"{work}/table.json", "w"), indent=1)
     print(f"   LinuxCNC session {lc_s:.0f} s")
 finally:
-    subprocess.run([SYS_PY, os.path.join(TOOLS, "run_program.py"), "--cleanup"], timeout=120)
-    t_end = time.monotonic() + 10
-    while linuxcnc_processes() and time.monotonic() < t_end:
-        time.sleep(0.5)
-    left = "\n".join(linuxcnc_processes())
-    check("no LinuxCNC process left (rtapi_app, milltask, linuxcncsvr, io, halcmd, linuxcnc)", not left, left)
-    print(f"   wall time {time.monotonic() - t0:.0f} s; work folder {work}")
-    if not check.failed and os.environ.get("LC_SAFETY_KEEP") != "1":
-        shutil.rmtree(work, ignore_errors=True)
+    finish_run(check, work, t0, keep=os.environ.get("LC_SAFETY_KEEP") == "1")
 check.finish()

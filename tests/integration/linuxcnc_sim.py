@@ -15,7 +15,6 @@ modules, or PyYAML are missing. Needs $PROBELOOP and $PROBELOOP_SOURCE_DIR."""
 import csv
 import json
 import os
-import shutil
 import subprocess
 import sys
 import tempfile
@@ -23,24 +22,10 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks  # noqa: E402
+from linuxcnc_common import SRC, SYS_PY, TOOLS, finish_run, skip_without_linuxcnc  # noqa: E402
 
-SRC = os.environ["PROBELOOP_SOURCE_DIR"]
+skip_without_linuxcnc("linuxcnc_sim")
 PL = os.environ["PROBELOOP"]
-TOOLS = os.path.join(SRC, "tools", "linuxcnc_sim")
-SYS_PY = "/usr/bin/python3"
-SKIP = 77
-
-
-def skip(why):
-    print("SKIP linuxcnc_sim: " + why)
-    sys.exit(SKIP)
-
-
-if not shutil.which("linuxcnc", path="/usr/sbin:/usr/bin:/sbin:/bin"):
-    skip("LinuxCNC is not installed (Debian: apt-get install linuxcnc-uspace)")
-if not os.path.exists(SYS_PY) or subprocess.run([SYS_PY, "-c", "import hal, linuxcnc, yaml"],
-                                                capture_output=True).returncode != 0:
-    skip("/usr/bin/python3 cannot import hal, linuxcnc and yaml (linuxcnc-uspace, python3-yaml)")
 
 check = Checks()
 NAMES = ["EX0C_um", "EY0C_um", "EZ0T_um", "ER0T_um", "EA0C_urad", "EB0C_urad", "EC0C_urad"]
@@ -93,17 +78,5 @@ try:
           ov and 0.0 <= ov["min"] and ov["max"] < 1.0, json.dumps(ov))
 finally:
     # sphere_run.py stops LinuxCNC itself, also on errors; should it have been killed, stop it here
-    subprocess.run([SYS_PY, os.path.join(TOOLS, "run_program.py"), "--cleanup"], timeout=120)
-    def linuxcnc_processes():   # running ones: a zombie waits for its parent (or init) to reap it
-        ps = subprocess.run(["ps", "-eo", "pid=,stat=,comm="], capture_output=True, text=True).stdout.splitlines()
-        return [row.strip() for row in ps if len(row.split()) == 3 and not row.split()[1].startswith("Z")
-                and row.split()[2] in ("rtapi_app", "milltask", "linuxcncsvr", "io", "halcmd", "linuxcnc")]
-    t_end = time.monotonic() + 10
-    while linuxcnc_processes() and time.monotonic() < t_end:
-        time.sleep(0.5)
-    left = "\n".join(linuxcnc_processes())
-    check("no LinuxCNC process left (rtapi_app, milltask, linuxcncsvr, io, halcmd, linuxcnc)", not left, left)
-    print(f"   wall time {time.monotonic() - t0:.0f} s; work folder {work}")
-    if not check.failed:
-        shutil.rmtree(work, ignore_errors=True)
+    finish_run(check, work, t0)
 check.finish()

@@ -16,6 +16,7 @@ Exit status: 0 if the program ran to its end without an error message, 1 otherwi
 Writes RUN_DIR/result.json (the display's messages) and RUN_DIR/linuxcnc.out (its output).
 """
 import argparse
+import fcntl
 import json
 import os
 import pwd
@@ -151,10 +152,25 @@ def stop_everything(proc, user, uid, run_dir, log):
     return left
 
 
+QUEUE_LOCK = "/tmp/probeloop-linuxcnc.flock"
+
+
 def run(run_dir, program, timeout=300.0, user="plsim", quiet=False):
     """Returns (ok, result dict). Raises RuntimeError if processes were left behind.
     program: one path, or a list of them, run in turn in one LinuxCNC session (result["programs"]
-    per program; timeout per program; ok = every one ran to its end without an error)."""
+    per program; timeout per program; ok = every one ran to its end without an error).
+    Only one LinuxCNC can run on a machine: a second caller waits for the first (an exclusive
+    flock on QUEUE_LOCK, released when the run ends or its process dies)."""
+    with open(QUEUE_LOCK, "a") as queue:
+        try:
+            os.chmod(QUEUE_LOCK, 0o666)
+        except PermissionError:
+            pass
+        fcntl.flock(queue, fcntl.LOCK_EX)
+        return _run_locked(run_dir, program, timeout, user, quiet)
+
+
+def _run_locked(run_dir, program, timeout, user, quiet):
     run_dir = os.path.abspath(run_dir)
     pw = ensure_user(user) if os.geteuid() == 0 else pwd.getpwuid(os.geteuid())
     user, uid = pw.pw_name, pw.pw_uid
@@ -234,7 +250,9 @@ def main():
             pw = pwd.getpwnam(a.user) if os.geteuid() == 0 else pwd.getpwuid(os.geteuid())
         except KeyError:
             return 0   # the user was never created: nothing ran
-        with open(os.devnull, "w") as log:
+        # after the run holding the queue, if any: what it runs is not left over
+        with open(QUEUE_LOCK, "a") as queue, open(os.devnull, "w") as log:
+            fcntl.flock(queue, fcntl.LOCK_EX)
             left = stop_everything(None, pw.pw_name, pw.pw_uid, "/tmp", log)
         if left:
             print("run_program: stopped what a previous run left: " + " ".join(map(str, left)))

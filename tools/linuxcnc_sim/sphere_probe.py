@@ -31,8 +31,20 @@ probing; 1 traverse, 2 feed, 3 arc, 4 tool change, 6 indexing rotary). A probing
 within micrometres of the contact; an intrusion during any other move is a collision the
 controller did not see. Only the tip ball is modelled, not the stylus shaft or the probe body.
 Every event carries "t", CLOCK_MONOTONIC in s (the display's per-program times use the same clock).
+A contact also carries the simulated clock, the errors in force and the external offsets in force
+(x/y/z-eoffset, fed from axis.L.eoffset).
+
+For the live loop (make_config.py --live, live_run.py): --truth may be a .csv trajectory (time_s
+and the seven errors, from a virtual-machine run); --clock-from start runs the simulated clock
+from this component's start, at --wait-time-scale while the live loop makes the program wait
+(the wait-s pin, live_offsets.py's, is > 0) and at --time-scale otherwise (a cycle), and
+publishes it on clock-s (-> motion.analog-in-01, which the live program logs with each point);
+--sample per_point moves the sphere with the clock at every moment; --inputs-source replays a
+recorded inputs CSV into --inputs-out as the clock passes each row's time_s (the data logger).
 """
 import argparse
+import bisect
+import csv
 import json
 import math
 import random
@@ -67,9 +79,19 @@ def small_length_um(v):
 
 
 class Truth:
-    """rigid_location_truth: piecewise-linear location errors, extrapolated with the last slope."""
+    """rigid_location_truth: piecewise-linear location errors, extrapolated with the last slope.
+    A .csv file is a trajectory instead (live_run.py writes one from a virtual-machine run):
+    time_s and the seven errors per row, linear between rows and held beyond the last (its probe
+    noise: --trajectory-noise-um)."""
 
-    def __init__(self, path):
+    def __init__(self, path, trajectory_noise_um=0.25):
+        if path.endswith(".csv"):
+            with open(path) as f:
+                rows = [r for r in csv.DictReader(line for line in f if not line.startswith("#"))]
+            self.knots = [(float(r["time_s"]), [float(r[n]) for n in NAMES]) for r in rows]
+            self.knots.append((self.knots[-1][0] + 1.0, self.knots[-1][1]))   # held, not extrapolated
+            self.noise_um = trajectory_noise_um
+            return
         with open(path) as f:
             doc = yaml.safe_load(f)
         if doc.get("kind") != "rigid_location_truth":
@@ -81,22 +103,61 @@ class Truth:
         k = self.knots
         if len(k) == 1:
             return dict(zip(NAMES, k[0][1]))
-        i = 0
-        while i < len(k) - 2 and t > k[i + 1][0]:
-            i += 1
+        i = bisect.bisect_left(self.times(), t) - 1
+        i = min(max(i, 0), len(k) - 2)
         (t0, v0), (t1, v1) = k[i], k[i + 1]
         w = (t - t0) / (t1 - t0)
         return {n: a + w * (b - a) for n, a, b in zip(NAMES, v0, v1)}
 
+    def times(self):
+        if not hasattr(self, "_times"):
+            self._times = [t for t, _ in self.knots]
+        return self._times
+
+
+class InputsLogger:
+    """The data logger of the live loop: the rows of a recorded inputs CSV (a virtual-machine
+    run's inputs.csv), appended to the output as the simulated clock passes their time_s."""
+
+    def __init__(self, source, out):
+        with open(source) as f:
+            lines = f.read().splitlines()
+        head = 0
+        while head < len(lines) and (lines[head].startswith("#") or not lines[head].strip()):
+            head += 1
+        self.rows = [(float(line.split(",", 1)[0]), line) for line in lines[head + 1:] if line.strip()]
+        self.next = 0
+        self.f = open(out, "w", buffering=1)
+        self.f.write("\n".join(lines[:head + 1]) + "\n")
+
+    def advance(self, sim_s):
+        chunk = []
+        while self.next < len(self.rows) and self.rows[self.next][0] <= sim_s:
+            chunk.append(self.rows[self.next][1])
+            self.next += 1
+        if chunk:
+            self.f.write("\n".join(chunk) + "\n")   # whole lines: a reader never sees a torn row
+
 
 def main():
-    ap = argparse.ArgumentParser()
+    ap = argparse.ArgumentParser(fromfile_prefix_chars="@")   # make_config.py passes an @file
     ap.add_argument("--name", default="pl_sphere")
     ap.add_argument("--manifest", required=True)
     ap.add_argument("--truth", required=True)
     ap.add_argument("--probe-tool", type=int, required=True)
     ap.add_argument("--probe-length", type=float, required=True, help="gauge line to stylus-tip centre, mm")
-    ap.add_argument("--time-scale", type=float, default=60.0)
+    ap.add_argument("--time-scale", type=float, default=60.0, help="simulated s per wall s")
+    ap.add_argument("--wait-time-scale", type=float, default=0.0,
+                    help="simulated s per wall s while the live loop makes the program wait (the wait-s pin > 0); "
+                         "0: --time-scale always")
+    ap.add_argument("--sample", choices=["per_cycle", "per_point"], default="per_cycle",
+                    help="per_cycle: the errors sampled at the probe load and held; per_point: at every moment")
+    ap.add_argument("--clock-from", choices=["first-load", "start"], default="first-load",
+                    help="the simulated clock's zero: the first probe load, or this component's start")
+    ap.add_argument("--trajectory-noise-um", type=float, default=0.25,
+                    help="probe noise (1 sigma) with a .csv trajectory as the truth")
+    ap.add_argument("--inputs-source", default="", help="recorded inputs CSV, replayed on the simulated clock")
+    ap.add_argument("--inputs-out", default="", help="where the replayed inputs are appended (the data logger's file)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--trigger", choices=["rt", "python"], default="rt")
     ap.add_argument("--poll-ms", type=float, default=1.0)
@@ -118,7 +179,7 @@ def main():
     cx0, cy0 = m["c_axis_centre_mm"]
     zc = art["sphere_centre_height_mm"]
     contact_r = art["sphere_radius_mm"] + probe["tip_radius_mm"]
-    truth = Truth(a.truth)
+    truth = Truth(a.truth, a.trajectory_noise_um)
     noise_mm = 0.0 if a.no_noise else truth.noise_um * 1e-3
     rng = random.Random(a.seed)
     FAR = 1.0e6
@@ -133,6 +194,10 @@ def main():
         c.newpin(p, hal.HAL_FLOAT, hal.HAL_OUT)
     c.newpin("probe-out", hal.HAL_BIT, hal.HAL_OUT)
     c.newpin("cycle", hal.HAL_S32, hal.HAL_OUT)
+    c.newpin("clock-s", hal.HAL_FLOAT, hal.HAL_OUT)      # the simulated clock (the inputs' time_s)
+    c.newpin("wait-s", hal.HAL_FLOAT, hal.HAL_IN)        # the wait the live loop asks for (live_offsets.py)
+    for p in ("x-eoffset", "y-eoffset", "z-eoffset"):    # the external offsets in force (recorded)
+        c.newpin(p, hal.HAL_FLOAT, hal.HAL_IN)
     c["sphere-z"] = FAR
     c["contact-radius"] = contact_r
     c.ready()
@@ -142,7 +207,9 @@ def main():
     signal.signal(signal.SIGINT, lambda *_: stop.append(1))
     rec = open(a.record, "a", buffering=1) if a.record else None
 
-    t_first = None
+    t_first = time.monotonic() if a.clock_from == "start" else None
+    sim_clock, t_prev = 0.0, None              # integrated: the rate differs with and without the probe
+    logger = InputsLogger(a.inputs_source, a.inputs_out) if a.inputs_source else None
     cycle = 0
     err = dict.fromkeys(NAMES, 0.0)
     radius = contact_r - noise_mm * rng.gauss(0.0, 1.0)
@@ -154,12 +221,23 @@ def main():
     next_t = time.monotonic()
     while not stop:
         loaded = c["tool-number"] == a.probe_tool
+        now = time.monotonic()
+        if t_first is None and loaded:
+            t_first = now
+        if t_first is not None:
+            if t_prev is not None:
+                waiting = a.wait_time_scale > 0 and c["wait-s"] > 0
+                rate = a.wait_time_scale if waiting else a.time_scale
+                sim_clock += (now - t_prev) * rate
+            t_prev = now
+        c["clock-s"] = sim_clock
+        if logger:
+            logger.advance(sim_clock)
+        if a.sample == "per_point" and t_first is not None:
+            err = truth.at(sim_clock)
         if loaded and not loaded_prev:           # the cycle's probe load: sample the truth and hold it
-            now = time.monotonic()
-            if t_first is None:
-                t_first = now
             cycle += 1
-            sim_s = (now - t_first) * a.time_scale
+            sim_s = sim_clock
             err = truth.at(sim_s)
             c["cycle"] = cycle
             if rec:
@@ -184,7 +262,8 @@ def main():
         if pin and not probe_prev and rec:
             rec.write(json.dumps({"event": "contact", "t": time.monotonic(), "cycle": cycle, "fb": [x, y, z, cdeg],
                                   "centre_tip_frame": [sx, sy, sz - a.probe_length], "radius": radius,
-                                  "motion_type": c["motion-type"]}) + "\n")
+                                  "motion_type": c["motion-type"], "sim_s": sim_clock, "errors": err,
+                                  "eoffset_mm": [c["x-eoffset"], c["y-eoffset"], c["z-eoffset"]]}) + "\n")
         depth = contact_r - math.sqrt((x - sx) ** 2 + (y - sy) ** 2 + (z - sz) ** 2) if loaded else -FAR
         if depth > a.intrusion_mm:
             if intrusion is None:
