@@ -2,12 +2,14 @@
 // this file parses, dispatches, maps the exit codes (cli/README.md) and commits the outputs.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 #include "cli/commands.hpp"
 #include "cli/model_commands.hpp"
 #include "cli/report_commands.hpp"
 #include "cli/separate_command.hpp"
+#include "cli/version.hpp"
 #include "core/atomic_file.hpp"
 
 using namespace probeloop;
@@ -16,6 +18,7 @@ int main(int argc, char** argv) {
   probeloop::removeTemporaryFileOnInterrupt();
   CLI::App app{"probeloop: plan, simulate and evaluate touch-probe cycles for machine-tool metrology"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string(cli::versionText()));
 
   std::vector<cli::Subcommand> commands{cli::addPlanCommand(app),     cli::addReadCommand(app),
                                         cli::addResolutionCommand(app), cli::addSynthCommand(app),
