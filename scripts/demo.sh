@@ -15,7 +15,7 @@ t_build=$SECONDS
 build_log=$(mktemp)
 set +e   # the build's own exit status, not the progress filter's
 TARGET=probeloop scripts/build.sh build 2>&1 | tee "$build_log" |
-  awk '/^\[[0-9]+\/[0-9]+\]/ && ++n % 25 == 0 {print "   " $1 " compiled"; fflush()}'
+  awk '/^\[[0-9]+\/[0-9]+\]/ && ++n % 10 == 0 {print "   " $1 " compiled"; fflush()}'
 rc=${PIPESTATUS[0]}
 set -e
 [ "$rc" = 0 ] || { tail -30 "$build_log" >&2; echo "demo.sh: the build failed (above)" >&2; exit 1; }
