@@ -45,7 +45,7 @@ volatile std::sig_atomic_t g_stop = 0;
 extern "C" void onStopSignal(int) { g_stop = 1; }
 
 // What the controller side reads (a HAL component, a FOCAS writer): replaced atomically.
-void writeControllerFile(const std::string& path, const campaign::LiveLoop& loop, double now_s) {
+void writeControllerFile(const std::string& path, const campaign::LiveLoop& loop, double now_s, bool live) {
   nlohmann::ordered_json j;
   j["time_s"] = now_s;
   j["phase"] = model::talcPhaseName(loop.phase());
@@ -58,9 +58,13 @@ void writeControllerFile(const std::string& path, const campaign::LiveLoop& loop
   } else {
     j["compensation"] = nullptr;
   }
-  // Live: the controller side reads it while the loop runs, so it cannot wait for the command's
-  // commit (core/atomic_file.hpp).
-  writeLiveFileAtomic(path, j.dump(1) + "\n");
+  // Following, the controller side reads it while the loop runs: it cannot wait for the
+  // command's commit (core/atomic_file.hpp). A single pass writes it with the other outputs.
+  if (live) {
+    writeLiveFileAtomic(path, j.dump(1) + "\n");
+  } else {
+    writeFileAtomic(path, j.dump(1) + "\n");
+  }
 }
 
 int runLive(const CampaignArgs& a) {
@@ -91,8 +95,15 @@ int runLive(const CampaignArgs& a) {
     const auto s = store.status();
     double now = s.inputs_last_time_s;
     for (const auto& c : s.cycles) now = std::max(now, c.time_s);
-    if (!a.dashboard.empty()) writeLiveFileAtomic(a.dashboard, campaign::liveDashboardHtml(store, loop, report::defaultVegaPath()));
-    if (!a.controller_file.empty()) writeControllerFile(a.controller_file, loop, now);
+    if (!a.dashboard.empty()) {
+      const std::string html = campaign::liveDashboardHtml(store, loop, report::defaultVegaPath());
+      if (a.follow) {
+        writeLiveFileAtomic(a.dashboard, html);
+      } else {
+        writeFileAtomic(a.dashboard, html);
+      }
+    }
+    if (!a.controller_file.empty()) writeControllerFile(a.controller_file, loop, now, a.follow);
     if (!a.follow || g_stop) break;
     idle_s = added > 0 || p.ticks > 0 || p.measurements > 0 ? 0 : idle_s + a.poll_s;
     if (a.idle_exit_s > 0 && idle_s >= a.idle_exit_s) break;

@@ -12,7 +12,7 @@ scripts/build.sh build
 phase "release build"
 (cd build && ctest --output-on-failure -j"$(nproc)" -E '^linuxcnc_')
 phase "release tests"
-# The tests on LinuxCNC in simulation (about 14 min, one LinuxCNC at a time) mostly wait for the
+# The tests on LinuxCNC in simulation (about 12 min, one LinuxCNC at a time) mostly wait for the
 # simulated machine's moves: they run beside the sanitizer build. Their contacts are decided in
 # LinuxCNC's servo thread, so a loaded machine delays them but does not move them (docs/linuxcnc.md).
 (cd build && { ctest --output-on-failure -R '^linuxcnc_' > linuxcnc_tests.log 2>&1 && rc=0 || rc=$?; echo "$rc" > linuxcnc_tests.rc; }) &

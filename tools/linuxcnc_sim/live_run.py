@@ -156,6 +156,7 @@ def main(argv=None):
             follower.wait(timeout=60)
         except subprocess.TimeoutExpired:
             follower.kill()
+            follower.wait()
         follow_out.close()
     wall = time.monotonic() - t0
     fin = subprocess.run([pl, "campaign", "run", store, "--log", log, "--inputs", inputs, "--finished",
@@ -187,6 +188,7 @@ def main(argv=None):
     with open(log) as f:
         lines = [line for line in f if line.startswith("PT ")]
     with open(pf_log, "w") as f:
+        # n-th contact = n-th PT line; the caller checks that the counts agree (summary.json)
         for line, c in zip(lines, contacts):
             t = line.split()
             xyz = [float(v) - o for v, o in zip(t[4:7], c["eoffset_mm"])]
@@ -220,6 +222,7 @@ def main(argv=None):
         c["in_effect"] = {"k": ks[-1], "values": {p["channel"]: p["value"] for p in predictions if p["k"] == ks[-1]}} \
             if ks else None
     summary = {"ok": ok, "linuxcnc_wall_s": wall, "messages": result.get("messages"), "cycles_run": len(cycles),
+               "contacts": len(contacts), "campaign_run_follow_rc": follower.returncode,
                "stored_cycles": stored, "talc_events": talc_events, "campaign_run_finished_rc": fin.returncode,
                "export_rc": exp.returncode, "export_error": exp.stderr.strip(), "points_logged": len(lines),
                "evaluate_rc": raw.returncode, "evaluate_error": raw.stderr.strip(),
