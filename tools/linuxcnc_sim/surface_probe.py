@@ -102,7 +102,9 @@ def main():
                     n = p["n"]
                     draw = rng.gauss(0.0, 1.0) * noise_mm if noise_mm > 0 else 0.0
                     radius = p["r"] - draw
-                    # radius first when activating, far offset first when deactivating
+                    # the servo thread may read between two pin writes: the plane is moved far away
+                    # first (no contact), then given its normal and radius, then its offset
+                    c["off"] = FAR
                     c["kx"], c["ky"], c["kz"] = n[0] * (1 + sx), n[1] * (1 + sy), n[2]
                     c["contact-radius"] = radius
                     c["off"] = -p["d"] - n[2] * L
