@@ -30,7 +30,7 @@ steps=$(python3 -c "import sqlite3; d = sqlite3.connect('$S'); print(d.execute('
 cycles=$(python3 -c "import sqlite3; d = sqlite3.connect('$S'); print(d.execute('SELECT COUNT(*) FROM talc_measurements').fetchone()[0])")
 "$PL" campaign run "$S" --finished --cp-h 36 >/dev/null
 t3=$(now)
-"$PL" campaign run "$S" --finished --cp-h 36 --dashboard "$W/dash.html" --controller-file "$W/c.json" >/dev/null
+"$PL" campaign run "$S" --finished --cp-h 36 --html "$W/dash.html" --controller-file "$W/c.json" >/dev/null
 t4=$(now)
 
 # One pass after each of the last 20 cycles, a process per pass (ingest, evaluate, TALC steps,
@@ -47,7 +47,7 @@ t5=$(now)
 for i in $(seq 1 20); do
   sed -n "$((first + 2 + (i - 1) * per + 1)),$((first + 2 + i * per))p" "$W/run/dprnt.txt" >> "$W/grow.log"
   "$PL" campaign run "$P" --log "$W/grow.log" --inputs "$W/grow.csv" --cp-h 36 \
-    --dashboard "$W/dash2.html" --controller-file "$W/c2.json" >/dev/null
+    --html "$W/dash2.html" --controller-file "$W/c2.json" >/dev/null
 done
 t6=$(now)
 

@@ -1,4 +1,4 @@
-// The live loop's HTML dashboard (`campaign run --dashboard`), rewritten after every pass.
+// The live loop's HTML dashboard (`campaign run --html`), rewritten after every pass.
 //
 // Contract (the page contract of report/vega.hpp: offline, Vega specs rendered by the inlined
 // runtime, every input string escaped, render errors in #vega-errors, deterministic):

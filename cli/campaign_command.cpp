@@ -282,7 +282,7 @@ Subcommand addCampaignCommands(CLI::App& app) {
   a->run->add_option("--grid-s", a->live.grid_s, "prediction grid = CP measurement interval, s (default: the plan's cycle period)")->check(CLI::PositiveNumber);
   a->run->add_flag("--offsets-applied", a->live.offsets_applied, "the controller applies the issued offsets: a cycle measures the residual");
   a->run->add_flag("--requested-only", a->live.requested_only, "feed TALC only the cycles it asked for (a densely measured log replayed)");
-  a->run->add_option("--dashboard", a->dashboard, "live HTML dashboard, rewritten after every pass");
+  a->run->add_option("--html", a->dashboard, "the live HTML dashboard, rewritten after every pass");
   a->run->add_option("--controller-file", a->controller_file, "JSON for the controller side: wait_s before the next cycle, the compensation in effect");
   a->add_input = group->add_subcommand("add-input", "Add an input column to the live loop's models while it runs (the "
                                                      "dashboard's diagnosis names the one they miss)");

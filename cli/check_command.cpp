@@ -25,7 +25,7 @@ int runCheck(const CheckArgs& a) {
     const auto machine = parts::loadMachine(a.machine);
     const auto piece = parts::loadTestPiece(a.part);
     std::vector<verify::ProgramText> texts;
-    for (const auto& f : a.programs) texts.push_back({f, readFile(f, kProgramInput)});
+    for (const auto& f : a.programs) texts.push_back({f, readProgramFile(f)});
     const auto r = verify::checkPrograms(texts, machine, piece);
     if (a.json) {
       std::fputs(verify::reportJson(r).c_str(), stdout);

@@ -57,8 +57,10 @@ int runEvaluate(const EvaluateArgs& a) {
 Subcommand addEvaluateCommand(CLI::App& app) {
   auto a = std::make_shared<EvaluateArgs>();
   auto* ev = app.add_subcommand("evaluate", "Errors of a test piece from probe logs, points CSV, a CMM export or dial-gauge readings");
-  ev->add_option("points", a->points, "LinuxCNC log, Fanuc DPRNT output, points CSV, CMM export (CSV, QIF 3.0 Results or DMIS output) or gauge CSV")->required()->check(inputFile());
-  ev->add_option("--manifest", a->manifest, "plan manifest (plan.json)")->required()->check(inputFile());
+  ev->add_option("measurements", a->points, "LinuxCNC log, Fanuc DPRNT output, points CSV, CMM export (CSV, QIF 3.0 Results or DMIS output) or gauge CSV")
+      ->required()->check(inputFile("the probe log or CMM export to evaluate"));
+  ev->add_option("--manifest", a->manifest, "plan manifest (plan.json)")->required()
+      ->check(inputFile("the plan.json that `probeloop plan` wrote"));
   ev->add_option("--out", a->out, "output folder")->capture_default_str();
   ev->add_option("--format", a->format, "auto, linuxcnc, fanuc, csv, cmm, qif, dmis or gauge")
       ->check(CLI::IsMember({"auto", "linuxcnc", "fanuc", "csv", "cmm", "qif", "dmis", "gauge"}))->capture_default_str();

@@ -6,7 +6,6 @@
 
 #include "cli/commands.hpp"
 #include "cli/input_option.hpp"
-#include "core/atomic_file.hpp"
 #include "core/csv.hpp"
 #include "core/error.hpp"
 #include "evaluate/feature_fit.hpp"
@@ -16,7 +15,7 @@ namespace probeloop::cli {
 namespace {
 
 struct FitArgs {
-  std::string kind, points, method = "ls", format = "auto", feature, material, approach, out;
+  std::string kind, points, method = "ls", format = "auto", feature, cycle, material, approach;
   double tip_radius_mm = 0.0;
   std::optional<double> radius_mm, outliers_k, point_u_um;
   int outlier_rounds = 10;
@@ -51,11 +50,14 @@ int runFit(const FitArgs& a) {
     req.side = a.material == "inside" ? geometry::MaterialSide::Inside : geometry::MaterialSide::Outside;
   if (!a.approach.empty()) req.approach = parseVector(a.approach, "--approach");
   if (a.point_u_um) req.point_u_mm = *a.point_u_um / 1000.0;
-  const auto cloud = evaluate::readPointCloud(a.points, a.format, a.feature);
+  const auto cloud = evaluate::readPointCloud(a.points, a.format, {a.feature, a.cycle});
   const auto rep = evaluate::fitFeature(cloud, req);
-  const std::string json = evaluate::featureFitJson(cloud, rep);
-  if (!a.out.empty()) writeFileAtomic(a.out, json);
-  std::fputs(a.json ? json.c_str() : evaluate::featureFitText(cloud, rep).c_str(), stdout);
+  if (a.json) {
+    std::fputs(evaluate::featureFitJson(cloud, rep).c_str(), stdout);
+    for (const auto& w : rep.warnings) std::fprintf(stderr, "probeloop: warning: %s\n", w.c_str());
+  } else {
+    std::fputs(evaluate::featureFitText(cloud, rep).c_str(), stdout);
+  }
   return 0;
 }
 
@@ -66,12 +68,13 @@ Subcommand addFitCommand(CLI::App& app) {
   auto* fit = app.add_subcommand("fit", "Fit one geometric element to a point cloud (CSV, NIST .ds, XYZ, PLY)");
   fit->add_option("kind", fa->kind, "line2d, line3d, plane, circle2d, circle3d, sphere, cylinder or cone")
       ->required()->check(CLI::IsMember({"line2d", "line3d", "plane", "circle2d", "circle3d", "sphere", "cylinder", "cone"}));
-  fit->add_option("points", fa->points, "points file")->required()->check(inputFile());
+  fit->add_option("points", fa->points, "points file")->required()->check(inputFile("a points file (CSV, NIST .ds, XYZ or PLY)"));
   fit->add_option("--method", fa->method, "ls (least squares), mz (minimum zone), mi (maximum inscribed), mc (minimum circumscribed)")
       ->check(CLI::IsMember({"ls", "mz", "mi", "mc"}))->capture_default_str();
   fit->add_option("--format", fa->format, "auto, csv, ds, xyz or ply")
       ->check(CLI::IsMember({"auto", "csv", "ds", "xyz", "ply"}))->capture_default_str();
-  fit->add_option("--feature", fa->feature, "points CSV: use the rows of this feature only");
+  fit->add_option("--feature", fa->feature, "points CSV: use the rows of this feature only (required when the file holds several)");
+  fit->add_option("--cycle", fa->cycle, "points CSV: use the rows of this cycle only (required when the file holds several)");
   fit->add_option("--tip-radius", fa->tip_radius_mm, "stylus tip radius, mm: the points are tip centres")->capture_default_str();
   fit->add_option("--material", fa->material, "material side for tip compensation when the file has no approach directions: inside (ball, shaft) or outside (bore)")
       ->check(CLI::IsMember({"inside", "outside"}));
@@ -81,8 +84,7 @@ Subcommand addFitCommand(CLI::App& app) {
   fit->add_option("--outlier-rounds", fa->outlier_rounds, "at most this many elimination rounds")->capture_default_str();
   fit->add_option("--outlier-max-fraction", fa->outlier_max_fraction, "refuse to drop more than this fraction")->capture_default_str();
   fit->add_option("--point-u", fa->point_u_um, "point standard uncertainty, um (type B parameter uncertainties)");
-  fit->add_flag("--json", fa->json, "print the JSON report instead of the text summary");
-  fit->add_option("--out", fa->out, "also write the JSON report to this file");
+  fit->add_flag("--json", fa->json, "print the JSON report instead of the text summary (warnings go to stderr)");
   return {fit, [fa] { return runFit(*fa); }};
 }
 

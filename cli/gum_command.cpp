@@ -8,15 +8,14 @@
 
 #include "cli/commands.hpp"
 #include "cli/input_option.hpp"
-#include "core/atomic_file.hpp"
 #include "parts/gum_model.hpp"
 
 namespace probeloop::cli {
 namespace {
 
 struct GumArgs {
-  std::string model, json;
-  bool mcm = false;
+  std::string model;
+  bool json = false, mcm = false;
   long trials = 0;
   int digits = 2;
   std::uint64_t seed = 1;
@@ -36,9 +35,7 @@ int runGum(const GumArgs& a) {
   }
   const auto r = uncertainty::evaluateTextModel(model, mo);
   if (mo && mo->progress) std::fprintf(stderr, "\r%40s\r", "");
-  if (!a.json.empty()) writeFileAtomic(a.json, uncertainty::textModelJson(model, r));
-  std::fputs(uncertainty::textModelReport(model, r).c_str(), stdout);
-  if (!a.json.empty()) std::printf("\nWrote %s\n", a.json.c_str());
+  std::fputs((a.json ? uncertainty::textModelJson(model, r) : uncertainty::textModelReport(model, r)).c_str(), stdout);
   return 0;
 }
 
@@ -52,7 +49,7 @@ Subcommand addGumCommand(CLI::App& app) {
   gum->add_option("--trials", a->trials, "Monte Carlo trials (0: adaptive, JCGM 101 7.9)")->capture_default_str()->check(CLI::NonNegativeNumber);
   gum->add_option("--digits", a->digits, "adaptive stop: significant digits of u (n_dig)")->capture_default_str()->check(CLI::Range(1, 4));
   gum->add_option("--seed", a->seed, "random seed")->capture_default_str();
-  gum->add_option("--json", a->json, "also write the results as JSON to this file");
+  gum->add_flag("--json", a->json, "print the results as JSON instead of the text report");
   return {gum, [a] { return runGum(*a); }};
 }
 

@@ -9,8 +9,16 @@
 
 namespace probeloop::cli {
 
-inline CLI::Validator inputFile() {
-  return CLI::Validator([](std::string& path) { return regularFileProblem(path); }, "FILE", "InputFile");
+// `expected` says what the option wants ("the plan.json that `probeloop plan` wrote"), so
+// that a missing file is refused with what should have been given.
+inline CLI::Validator inputFile(const std::string& expected = "") {
+  return CLI::Validator(
+      [expected](std::string& path) {
+        std::string problem = regularFileProblem(path);
+        if (!problem.empty() && !expected.empty()) problem += "; expected " + expected;
+        return problem;
+      },
+      "FILE", "InputFile");
 }
 
 }  // namespace probeloop::cli

@@ -12,6 +12,7 @@
 #include "core/atomic_file.hpp"
 #include "core/csv.hpp"
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 #include "parts/json_file.hpp"
 #include "model/diagnose.hpp"
 #include "model/stepped_series.hpp"
@@ -30,7 +31,8 @@ namespace {
 
 struct ModelArgs {
   std::vector<std::string> models;
-  std::string inputs, errors, json, report, part;
+  std::string inputs, errors, html, part;
+  bool json = false;
   // add
   std::string kind, model, channels, input, lever;
   std::optional<double> tau_s, alpha, length_mm;
@@ -64,10 +66,11 @@ std::optional<model::ExpansionLevers> expansionLevers(const std::string& part) {
   return parts::expansionLevers(parts::loadTestPiece(part));
 }
 
-void writeReport(const std::string& path, const nlohmann::json& fit, const nlohmann::json* diag) {
+// "Wrote" goes to stderr when stdout carries JSON.
+void writeReport(const std::string& path, const nlohmann::json& fit, const nlohmann::json* diag, bool json) {
   if (path.empty()) return;
   writeFileAtomic(path, report::modelReportHtml(fit, diag));
-  std::printf("\nWrote %s\n", path.c_str());
+  std::fprintf(json ? stderr : stdout, "%sWrote %s\n", json ? "" : "\n", path.c_str());
 }
 
 int runFit(const ModelArgs& a) {
@@ -75,9 +78,8 @@ int runFit(const ModelArgs& a) {
   const auto c = campaignFor(m, a);
   const auto f = model::fitModel(c, m);
   const auto j = model::fitJson(c, m, f);
-  if (!a.json.empty()) writeFileAtomic(a.json, j.dump(1) + "\n");
-  std::fputs(model::fitText(c, m, f).c_str(), stdout);
-  writeReport(a.report, j, nullptr);
+  std::fputs(a.json ? (j.dump(1) + "\n").c_str() : model::fitText(c, m, f).c_str(), stdout);
+  writeReport(a.html, j, nullptr, a.json);
   return 0;
 }
 
@@ -87,8 +89,7 @@ int runCompare(const ModelArgs& a) {
   const auto c = campaignFor(ms.front(), a);
   std::vector<model::ModelFit> fits;
   for (const auto& m : ms) fits.push_back(model::fitModel(c, m, ms.front().training_fraction));
-  if (!a.json.empty()) writeFileAtomic(a.json, model::compareJson(c, ms, fits).dump(1) + "\n");
-  std::fputs(model::compareText(c, ms, fits).c_str(), stdout);
+  std::fputs(a.json ? (model::compareJson(c, ms, fits).dump(1) + "\n").c_str() : model::compareText(c, ms, fits).c_str(), stdout);
   return 0;
 }
 
@@ -101,13 +102,12 @@ int runDiagnose(const ModelArgs& a) {
   opt.model_path = a.models.front();
   const auto d = model::diagnose(c, m, opt);
   const auto dj = model::diagnosisJson(c, m, d);
-  if (!a.json.empty()) writeFileAtomic(a.json, dj.dump(1) + "\n");
-  std::fputs(model::diagnosisText(c, m, d).c_str(), stdout);
-  if (!a.report.empty()) {
+  std::fputs(a.json ? (dj.dump(1) + "\n").c_str() : model::diagnosisText(c, m, d).c_str(), stdout);
+  if (!a.html.empty()) {
     model::ModelFit f;
     f.after = d.fits;
     f.train_end = model::trainingEnd(c.errors.size(), m.training_fraction);
-    writeReport(a.report, model::fitJson(c, m, f), &dj);
+    writeReport(a.html, model::fitJson(c, m, f), &dj, a.json);
   }
   return 0;
 }
@@ -128,6 +128,33 @@ int runAdd(const ModelArgs& a) {
     chans.push_back(s);
   }
   if (chans.empty()) throw InputError("", 0, "model add: --channels lists no channel");
+  // Checked against the model's data before anything is written: a channel or input that the
+  // data lack would only fail at the next fit, and "EY0C" for "EY0C_um" would be fitted twice.
+  std::string checked = "(not checked: the model file names no data)";
+  if (!m.inputs_path.empty() && !m.errors_path.empty()) {
+    const auto c = campaignFor(m, a);
+    auto list = [](const std::vector<std::string>& v) {
+      std::string s;
+      for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+      return s;
+    };
+    for (auto& name : chans) {
+      const int k = c.errors.channel(name);
+      if (k < 0)
+        throw InputError(a.model, 0, "model add: no channel '" + name + "' in " + c.errors.file + "; its channels: " +
+                                         list(c.errors.channels));
+      if (c.errors.channels[static_cast<size_t>(k)] != name) {
+        std::printf("Channel %s is %s in %s.\n", name.c_str(), c.errors.channels[static_cast<size_t>(k)].c_str(),
+                    c.errors.file.c_str());
+        name = c.errors.channels[static_cast<size_t>(k)];
+      }
+    }
+    for (const auto* in : {&a.input, &a.lever})
+      if (!in->empty() && c.inputs.column(*in) < 0)
+        throw InputError(a.model, 0, "model add: no input '" + *in + "' in " + c.inputs.file + "; its inputs: " +
+                                         list(c.inputs.names));
+    checked = "(checked against " + c.errors.file + " and " + c.inputs.file + ")";
+  }
   model::Effect e = model::makeEffect(*kind, a.input);
   if (*kind == model::EffectKind::Drift && !a.input.empty())
     throw InputError("", 0, "model add drift: a drift reads no input; leave out --input");
@@ -169,11 +196,17 @@ int runAdd(const ModelArgs& a) {
       if (have.id() == ce.id()) throw InputError(a.model, 0, "channels." + name + ": already has " + ce.id());
     it->effects.push_back(ce);
   }
-  parts::saveErrorModel(m, a.model);
-  std::printf("Added %s to %s in %s", e.id().c_str(), a.channels.c_str(), a.model.c_str());
+  const auto patched = parts::patchErrorModelText(readFile(a.model, kYamlInput), m);
+  if (patched) writeFileAtomic(a.model, *patched);
+  else parts::saveErrorModel(m, a.model);
+  std::string names;
+  for (const auto& n : chans) names += (names.empty() ? "" : ",") + n;
+  std::printf("Added %s to %s in %s %s", e.id().c_str(), names.c_str(), a.model.c_str(), checked.c_str());
   if (!created.empty()) std::printf(" (new channels: %zu)", created.size());
-  std::printf(".\nThe file was rewritten in canonical form (comments are not kept). Next, to see before and after:\n"
-              "  probeloop model fit %s\n", a.model.c_str());
+  std::printf(".\n%s Next, to see before and after:\n  probeloop model fit %s\n",
+              patched ? "The file keeps its comments and layout; the new lines are marked just_added."
+                      : "The file was rewritten in canonical form (its layout was not one model add edits in place; comments are not kept).",
+              a.model.c_str());
   return 0;
 }
 
@@ -227,12 +260,12 @@ std::function<int()> addModelCommands(CLI::App& app, CLI::App*& group) {
   auto data = [a](CLI::App* s) {
     s->add_option("--inputs", a->inputs, "inputs.csv of the campaign (default: data.inputs of the model file)")->check(cli::inputFile());
     s->add_option("--errors", a->errors, "errors.csv of the campaign (default: data.errors of the model file)")->check(cli::inputFile());
-    s->add_option("--json", a->json, "also write the results as JSON to this file");
+    s->add_flag("--json", a->json, "print the results as JSON instead of the text");
   };
   auto* fit = group->add_subcommand("fit", "Fit the model on the training span, predict the validation span, report the indicators");
   fit->add_option("model", a->models, "error model (YAML, kind: error_model)")->required()->expected(1)->check(cli::inputFile());
   data(fit);
-  fit->add_option("--report", a->report, "also write the HTML report to this file");
+  fit->add_option("--html", a->html, "also write the HTML report to this file");
   auto* cmp = group->add_subcommand("compare", "Several models on the same campaign, side by side");
   cmp->add_option("models", a->models, "error models (YAML)")->required()->expected(1, 20)->check(cli::inputFile());
   data(cmp);
@@ -240,7 +273,7 @@ std::function<int()> addModelCommands(CLI::App& app, CLI::App*& group) {
   dia->add_option("model", a->models, "error model (YAML)")->required()->expected(1)->check(cli::inputFile());
   data(dia);
   dia->add_option("--part", a->part, "the test piece (YAML: sphere artifact, thermal test piece): enables its expansion candidates")->check(cli::inputFile());
-  dia->add_option("--report", a->report, "also write the HTML report to this file");
+  dia->add_option("--html", a->html, "also write the HTML report to this file");
   auto* add = group->add_subcommand("add", "Add an effect to channels of a model file (marked just_added: the next fit shows before and after)");
   add->add_option("effect", a->kind, "drift, static, lag, transient or expansion")
       ->required()->check(CLI::IsMember({"drift", "static", "lag", "transient", "expansion"}));

@@ -21,6 +21,12 @@ struct ReadArgs {
 
 int runRead(const ReadArgs& a) {
   const std::string text = readFile(a.file);
+  if (!interop::looksLikeDmis(text) && text.find_first_not_of(" \t\r\n\xEF\xBB\xBF") != std::string::npos &&
+      text[text.find_first_not_of(" \t\r\n\xEF\xBB\xBF")] != '<') {
+    const std::string kind = describeContent(text);
+    throw InputError(a.file, 0, "this is " + (kind.empty() ? std::string("not a file probeloop recognises") : kind) +
+                                    "; `probeloop read` reads QIF 3.0 (XML) and DMIS files");
+  }
   if (interop::looksLikeDmis(text)) {  // a program (DMISMN: its nominals and PTMEAS points) or output (FILNAM)
     const bool program = interop::isDmisProgram(text);
     const auto d = program ? interop::parseDmisProgram(text, a.file) : interop::parseDmisOutput(text, a.file);

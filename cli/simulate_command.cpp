@@ -42,7 +42,7 @@ int runSimulate(const SimulateArgs& a) {
   if (!a.cmm_points.empty()) sim::loadCmmRequest(part, a.cmm_points);
   part.trace = a.trace;
   std::vector<sim::ProgramSource> programs;
-  for (const auto& f : a.programs) programs.push_back({f, readFile(f, kProgramInput), std::nullopt});
+  for (const auto& f : a.programs) programs.push_back({f, readProgramFile(f), std::nullopt});
   if (!a.schedule.empty()) sim::scheduleFromManifest(programs, a.schedule);
   if (a.until_h > 0) part.until_s = a.until_h * 3600.0;
   // The live loop on the controller side: its store follows the log and the inputs as the

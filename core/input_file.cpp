@@ -323,8 +323,25 @@ std::string describeContent(const std::string& text) {
     }
   }
   if (gcode) return "a G-code program";
-  if (first.find(',') != std::string::npos || first.find(';') != std::string::npos)
-    return "a CSV table (first line '" + first.substr(0, 60) + (first.size() > 60 ? "...'" : "'") + ")";
+  if (first.find(',') != std::string::npos || first.find(';') != std::string::npos) {
+    // probeloop's own tables by their header (docs/formats.md), so that a file given in
+    // another's place is named: the evaluated errors, the logged inputs, probe points.
+    const std::string quoted = "'" + first.substr(0, 60) + (first.size() > 60 ? "...'" : "'");
+    auto has = [&](const char* column) {
+      const std::string c(column);
+      const std::size_t i = first.find(c);
+      return i != std::string::npos && (i == 0 || first[i - 1] == ',' || first[i - 1] == ';') &&
+             (i + c.size() == first.size() || first[i + c.size()] == ',' || first[i + c.size()] == ';');
+    };
+    if (first.rfind("time_s", 0) == 0) {
+      if (has("cycle") && first.find("U_") != std::string::npos)
+        return "an errors.csv of `probeloop evaluate` (first line " + quoted + ")";
+      if (!has("cycle") && !has("x_mm") && (first.find("T_") != std::string::npos || has("c_rpm") || has("spindle_rpm")))
+        return "an inputs.csv of logged machine inputs (first line " + quoted + ")";
+    }
+    if (has("x_mm") && has("y_mm") && has("z_mm")) return "a points CSV (first line " + quoted + ")";
+    return "a CSV table (first line " + quoted + ")";
+  }
   // `key:` or `key: value`: a YAML mapping.
   if (!first.empty() && (std::isalpha(static_cast<unsigned char>(first[0])) || first[0] == '_')) {
     std::size_t i = 0;
@@ -332,6 +349,18 @@ std::string describeContent(const std::string& text) {
     if (i < first.size() && first[i] == ':' && (i + 1 == first.size() || first[i + 1] == ' ')) return "a YAML document";
   }
   return "";
+}
+
+std::string readProgramFile(const std::string& path) {
+  std::string text = readFile(path, kProgramInput);
+  // Only kinds a program cannot be mistaken for: a ';' comment line looks like a CSV table
+  // and a `word:` line like YAML, so those are left to the interpreter's own messages.
+  const std::string kind = describeContent(text);
+  for (const char* other : {"a JSON", "a glTF", "a QIF", "an XML", "an HTML", "a YAML description", "a DMIS",
+                            "a probe log", "an errors.csv", "an inputs.csv", "a points CSV"})
+    if (kind.rfind(other, 0) == 0)
+      throw InputError(path, 0, "this is " + kind + ", not a G-code program (.ngc for LinuxCNC, .nc for Fanuc macro B)");
+  return text;
 }
 
 }  // namespace probeloop

@@ -52,7 +52,13 @@ std::string regularFileProblem(const std::string& path);
 
 // What a text looks like, for messages when a reader gets a file of another kind: "a QIF
 // (XML) document", "a DMIS file", "a JSON document", "a YAML description (kind: ...)",
-// "a LinuxCNC probe log", "a G-code program", ... ; empty when nothing is recognised.
+// "a LinuxCNC probe log", "a G-code program", "an errors.csv of `probeloop evaluate`",
+// "an inputs.csv of logged machine inputs", "a points CSV", "a CSV table (first line ...)";
+// empty when nothing is recognised.
 std::string describeContent(const std::string& text);
+
+// readFile(path, kProgramInput), refusing a file that is plainly of another kind (a plan
+// manifest, a probe log, a YAML description, ...) with a sentence naming what it is.
+std::string readProgramFile(const std::string& path);
 
 }  // namespace probeloop

@@ -132,6 +132,14 @@ TEST(DescribeContent, NamesTheKindsProbeloopMeets) {
   EXPECT_EQ(describeContent("N10 X1, Y2\n"), "a CSV table (first line 'N10 X1, Y2')");
   EXPECT_EQ(describeContent("title: a model\nkind: gum_model\r\n"), "a YAML description (kind: gum_model)");
   EXPECT_EQ(describeContent("title: a model\n"), "a YAML document");
+  // probeloop's own tables, named by their header.
+  EXPECT_EQ(describeContent("# probeloop evaluate\ntime_s,cycle,EX0C_um,U_EX0C_um\n1,1,0.5,0.2\n"),
+            "an errors.csv of `probeloop evaluate` (first line 'time_s,cycle,EX0C_um,U_EX0C_um')");
+  EXPECT_EQ(describeContent("time_s,T_env_C,c_rpm\n0,20,0\n"),
+            "an inputs.csv of logged machine inputs (first line 'time_s,T_env_C,c_rpm')");
+  EXPECT_EQ(describeContent("time_s,cycle,c_deg,feature,point,x_mm,y_mm,z_mm\n"),
+            "a points CSV (first line 'time_s,cycle,c_deg,feature,point,x_mm,y_mm,z_mm')");
+  EXPECT_EQ(describeContent("time_s,cycle_count\n"), "a CSV table (first line 'time_s,cycle_count')");  // not 'cycle'
 }
 
 // A hostile token (a 5 MB line) is echoed in a few dozen characters, with its length.

@@ -9,6 +9,7 @@
 
 #include "core/csv.hpp"
 #include "core/error.hpp"
+#include "uncertainty/gum.hpp"
 
 namespace probeloop::evaluate {
 namespace {
@@ -119,6 +120,21 @@ FeatureFitReport fitFeature(const PointCloud& cloud, const FeatureFitRequest& re
     rep.uncertainty_basis = "type A: residual standard deviation s = " +
                             formatNumber(um(rep.residual_s_mm), 4) + " um, nu = " +
                             std::to_string(f.dof) + ", propagated through (J^T J)^-1";
+    // A type A u from a handful of residuals is itself barely known (its relative u is about
+    // 1/sqrt(2 nu), GUM G.4.2 / E.4.3), and residuals at rounding level say nothing of the points.
+    if (rep.residual_s_mm < kRoundingLevelMm)
+      rep.warnings.push_back("the residuals are at rounding level (s = " + [&] {
+        char b[32];
+        std::snprintf(b, sizeof b, "%.2g", um(rep.residual_s_mm));
+        return std::string(b);
+      }() + " um): the points lie exactly on the element, so u from them means nothing; "
+                             "give --point-u (the probing's standard uncertainty)");
+    else if (f.dof < kMinDofForTypeA)
+      rep.warnings.push_back("nu = " + std::to_string(f.dof) + ": the type A u rests on " + std::to_string(f.dof) +
+                             " degree(s) of freedom (its own relative u is about " +
+                             std::to_string(static_cast<int>(std::lround(100.0 / std::sqrt(2.0 * f.dof)))) + " %; the 95 % coverage factor is t = " +
+                             formatNumber(uncertainty::coverageFactor(0.95, f.dof), 3) +
+                             ", not 2); measure more points or give --point-u");
   } else {
     rep.uncertainty_basis =
         "none: exact fit (n = number of parameters) has no residual scatter; give --point-u";
@@ -195,6 +211,7 @@ std::string featureFitJson(const PointCloud& cloud, const FeatureFitReport& rep)
   nlohmann::ordered_json support = nlohmann::ordered_json::array();
   for (int s : f.support_points) support.push_back(rep.fit.kept[static_cast<size_t>(s)] + 1);
   j["support_points"] = support;
+  j["warnings"] = rep.warnings;
   return j.dump(2) + "\n";
 }
 
@@ -238,6 +255,7 @@ std::string featureFitText(const PointCloud& cloud, const FeatureFitReport& rep)
     }
   }
   if (!f.support_points.empty()) o << "  support points: " << f.support_points.size() << "\n";
+  for (const auto& w : rep.warnings) o << "  warning: " << w << "\n";
   return o.str();
 }
 

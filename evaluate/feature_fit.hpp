@@ -17,6 +17,7 @@
 #pragma once
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "evaluate/point_cloud.hpp"
 #include "geometry/fit.hpp"
@@ -47,7 +48,13 @@ struct FeatureFitReport {
   std::optional<geometry::MaterialSide> side_used;
   std::string side_source;  // "approach directions in the file", "--material", ...
   double residual_min_mm = 0, residual_max_mm = 0, residual_s_mm = 0;
+  // What the user must know before trusting the u: too few degrees of freedom for a type A u
+  // (nu < kMinDofForTypeA), or residuals at rounding level (s < kRoundingLevelMm).
+  std::vector<std::string> warnings;
 };
+
+inline constexpr int kMinDofForTypeA = 5;          // t(95 %, nu = 5) = 2.57: already 28 % above k = 2
+inline constexpr double kRoundingLevelMm = 1e-7;   // 0.1 nm: below any probe's resolution
 
 FeatureFitReport fitFeature(const PointCloud& cloud, const FeatureFitRequest& request);
 std::string featureFitJson(const PointCloud& cloud, const FeatureFitReport& report);

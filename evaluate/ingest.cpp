@@ -175,6 +175,12 @@ std::vector<ProbeRecord> readProbeRecords(const std::string& path, PointsFormat 
       throw InputError(path, 0, "this is " + kind + "; a sphere-artifact campaign is evaluated from the probe log the "
                                 "cycle writes (LinuxCNC LOG or Fanuc DPRNT: PT lines) or a points CSV");
   }
+  if (format == PointsFormat::PointsCsv) {
+    const std::string kind = describeContent(text);
+    if (kind.rfind("an errors.csv", 0) == 0 || kind.rfind("an inputs.csv", 0) == 0)
+      throw InputError(path, 0, "this is " + kind + "; a sphere-artifact campaign is evaluated from the probe log the "
+                                "cycle writes (LinuxCNC LOG or Fanuc DPRNT: PT lines) or a points CSV (x_mm,y_mm,z_mm)");
+  }
   std::vector<ProbeRecord> out = format == PointsFormat::PointsCsv ? fromCsv(text, path, m) : probeLogRecords(text, path);
   if (out.empty())
     throw InputError(path, 0, "no probe points in the file: nothing to evaluate (expected the cycle's PT lines or points CSV rows)");

@@ -60,7 +60,18 @@ Eigen::Vector3d threeNumbers(const std::vector<std::string>& t, const std::strin
   return p;
 }
 
-void readCsv(PointCloud& pc, const std::string& text, const std::string& feature) {
+// "S1, S2, S3 … S5" for a hint: the distinct values of a column in file order.
+std::string listValues(const std::vector<std::string>& values) {
+  std::string out;
+  for (size_t i = 0; i < values.size(); ++i) {
+    if (i == 3 && values.size() > 4) return out + " ... " + values.back();
+    out += (i ? ", " : "") + values[i];
+  }
+  return out;
+}
+
+void readCsv(PointCloud& pc, const std::string& text, const PointSelection& select) {
+  const std::string& feature = select.feature;
   const CsvTable t = parseCsv(text, pc.file);
   auto col = [&](const char* a, const char* b) {
     const int c = t.column(a);
@@ -78,8 +89,35 @@ void readCsv(PointCloud& pc, const std::string& text, const std::string& feature
   const int cf = t.column("feature");
   if (!feature.empty() && cf < 0)
     throw InputError(pc.file, t.header_line, "--feature given but the file has no 'feature' column");
+  const int cc = t.column("cycle");
+  if (!select.cycle.empty() && cc < 0)
+    throw InputError(pc.file, t.header_line, "--cycle given but the file has no 'cycle' column");
+  // A campaign file (simulate's points.csv, a probe log turned CSV) holds several features and
+  // cycles; fitting them as one cloud gives a meaningless element, so the file must be narrowed.
+  auto distinct = [&](int column) {
+    std::vector<std::string> values;
+    if (column < 0) return values;
+    for (const auto& row : t.rows) {
+      const std::string& v = row.fields[static_cast<size_t>(column)];
+      if (std::find(values.begin(), values.end(), v) == values.end()) values.push_back(v);
+    }
+    return values;
+  };
+  const auto features = distinct(cf), cycles = distinct(cc);
+  if (feature.empty() && features.size() > 1)
+    throw InputError(pc.file, t.header_line,
+                     "the file holds " + std::to_string(features.size()) + " features (" + listValues(features) +
+                         "): choose one with --feature NAME" +
+                         (cycles.size() > 1 ? " and one of its " + std::to_string(cycles.size()) +
+                                                  " cycles with --cycle N"
+                                            : ""));
+  if (select.cycle.empty() && cycles.size() > 1)
+    throw InputError(pc.file, t.header_line,
+                     "the file holds " + std::to_string(cycles.size()) + " cycles (" + listValues(cycles) +
+                         "): choose one with --cycle N");
   for (const auto& row : t.rows) {
     if (!feature.empty() && row.fields[static_cast<size_t>(cf)] != feature) continue;
+    if (!select.cycle.empty() && row.fields[static_cast<size_t>(cc)] != select.cycle) continue;
     pc.points_mm.emplace_back(t.number(row, cx), t.number(row, cy), t.number(row, cz));
     pc.source_lines.push_back(row.line);
     if (has_n) {
@@ -90,8 +128,12 @@ void readCsv(PointCloud& pc, const std::string& text, const std::string& feature
       pc.approach.push_back(n);
     }
   }
-  if (!feature.empty() && pc.points_mm.empty())
-    throw InputError(pc.file, 0, "no rows with feature '" + feature + "'");
+  if (!feature.empty() && std::find(features.begin(), features.end(), feature) == features.end())
+    throw InputError(pc.file, 0, "no rows with feature '" + feature + "'; the file's features: " + listValues(features));
+  if (!select.cycle.empty() && std::find(cycles.begin(), cycles.end(), select.cycle) == cycles.end())
+    throw InputError(pc.file, 0, "no rows of cycle " + select.cycle + "; the file's cycles: " + listValues(cycles));
+  if (pc.points_mm.empty())
+    throw InputError(pc.file, 0, "no rows of feature '" + feature + "' in cycle " + select.cycle);
 }
 
 // The largest count of points or PLY elements a header may declare (far above any cloud that
@@ -349,15 +391,18 @@ void readPly(PointCloud& pc, const std::string& text) {
 }  // namespace
 
 PointCloud readPointCloud(const std::string& path, const std::string& format_in,
-                          const std::string& feature) {
+                          const PointSelection& select) {
+  const std::string& feature = select.feature;
   PointCloud pc;
   pc.file = path;
   pc.format = format_in == "auto" || format_in.empty() ? extensionFormat(path) : format_in;
   if (!feature.empty() && pc.format != "csv")
     throw InputError(path, 0, "--feature selects rows of a points CSV; this file is " + pc.format);
+  if (!select.cycle.empty() && pc.format != "csv")
+    throw InputError(path, 0, "--cycle selects rows of a points CSV; this file is " + pc.format);
   // Binary PLY holds NUL bytes; every other format is text (NUL refused, UTF-16 transcoded).
   const std::string text = readFile(path, pc.format == "ply" ? kPointCloudInput : kAnyInput);
-  if (pc.format == "csv") readCsv(pc, text, feature);
+  if (pc.format == "csv") readCsv(pc, text, select);
   else if (pc.format == "ds") readDs(pc, text);
   else if (pc.format == "xyz") readXyz(pc, text);
   else if (pc.format == "ply") readPly(pc, text);

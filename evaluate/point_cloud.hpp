@@ -4,7 +4,9 @@
 // Contract:
 // - csv: a header row; coordinates from columns x_mm,y_mm,z_mm (or x,y,z); optional unit
 //   approach directions nx,ny,nz (the canonical points CSV of docs/architecture.md#data-contracts qualifies; its
-//   other columns are ignored, and `feature` selects rows when a feature is asked for).
+//   other columns are ignored). A file with a `feature` or `cycle` column holding more than
+//   one value (a campaign's points) must be narrowed by the selection: otherwise an error
+//   lists the values and names --feature / --cycle.
 // - ds: NIST algorithm-testing format, first line N, then N lines "x y z".
 // - xyz: one point per line, >= 3 numbers separated by blanks or commas, '#' comments;
 //   extra columns are ignored.
@@ -29,7 +31,13 @@ struct PointCloud {
   std::vector<int> source_lines;       // 1-based line of each point (ply binary: 0)
 };
 
+// Rows of a points CSV to fit: the `feature` and `cycle` columns' values (empty: not selected).
+struct PointSelection {
+  std::string feature;
+  std::string cycle;
+};
+
 PointCloud readPointCloud(const std::string& path, const std::string& format = "auto",
-                          const std::string& feature = "");
+                          const PointSelection& select = {});
 
 }  // namespace probeloop::evaluate

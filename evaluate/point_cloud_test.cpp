@@ -39,13 +39,47 @@ TEST(PointCloud, CanonicalCsvWithApproachAndFeatureFilter) {
                            "0,1,0,bore,1,10.5,0,3,1,0,0\n"
                            "1,1,0,top,1,0,0,8,0,0,-1\n"
                            "2,1,0,bore,2,0,10.5,3,0,1,0\n");
-  const auto pc = readPointCloud(p, "auto", "bore");
+  const auto pc = readPointCloud(p, "auto", {"bore", ""});
   ASSERT_EQ(pc.points_mm.size(), 2u);
   EXPECT_EQ(pc.format, "csv");
   EXPECT_EQ(pc.points_mm[1], Eigen::Vector3d(0, 10.5, 3));
   EXPECT_EQ(pc.approach[1], Eigen::Vector3d(0, 1, 0));
   EXPECT_EQ(pc.source_lines[1], 5);
-  EXPECT_EQ(readPointCloud(p).points_mm.size(), 3u);
+  // Two features in one cloud would fit one element to both: refused, naming them.
+  try {
+    readPointCloud(p);
+    FAIL() << "a file of two features was fitted as one cloud";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("2 features (bore, top): choose one with --feature"), std::string::npos) << e.what();
+  }
+}
+
+TEST(PointCloud, CampaignFileNeedsTheCycleAndTheFeatureNamed) {
+  std::string text = "time_s,cycle,c_deg,feature,point,x_mm,y_mm,z_mm\n";
+  for (int cycle = 1; cycle <= 12; ++cycle)
+    for (const char* f : {"S1", "S2"})
+      for (int k = 0; k < 4; ++k)
+        text += std::to_string(cycle * 100 + k) + "," + std::to_string(cycle) + ",0," + f + "," +
+                std::to_string(k + 1) + "," + std::to_string(k) + "," + std::to_string(k * k) + ",1\n";
+  const auto p = writeTemp("campaign.csv", text);
+  auto message = [&](const PointSelection& s) {
+    try {
+      readPointCloud(p, "auto", s);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_NE(message({}).find("2 features (S1, S2): choose one with --feature NAME and one of its 12 cycles with --cycle N"),
+            std::string::npos) << message({});
+  EXPECT_NE(message({"S2", ""}).find("12 cycles (1, 2, 3 ... 12): choose one with --cycle N"), std::string::npos)
+      << message({"S2", ""});
+  EXPECT_NE(message({"S2", "13"}).find("no rows of cycle 13"), std::string::npos);
+  EXPECT_NE(message({"S3", "2"}).find("no rows with feature 'S3'; the file's features: S1, S2"), std::string::npos);
+  const auto pc = readPointCloud(p, "auto", {"S2", "7"});
+  ASSERT_EQ(pc.points_mm.size(), 4u);
+  EXPECT_EQ(pc.points_mm[3], Eigen::Vector3d(3, 9, 1));
+  EXPECT_EQ(pc.source_lines[0], 2 + (7 - 1) * 8 + 4);  // header, six cycles of 8 rows, S1's 4
 }
 
 TEST(PointCloud, CsvErrorsNameFileLineAndField) {

@@ -11,5 +11,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   static fuzz::ScratchFile file(".csv");
   const std::string& path = file.write(data, size);
   fuzz::expectRefusalOrSuccess([&] { evaluate::readPointCloud(path, "csv"); });
-  return fuzz::expectRefusalOrSuccess([&] { evaluate::readPointCloud(path, "csv", "S1"); });
+  fuzz::expectRefusalOrSuccess([&] { evaluate::readPointCloud(path, "csv", {"S1", ""}); });
+  return fuzz::expectRefusalOrSuccess([&] { evaluate::readPointCloud(path, "csv", {"S1", "2"}); });
 }

@@ -12,8 +12,18 @@
 namespace probeloop::model {
 namespace {
 
-CsvTable readTable(const std::string& path) {
-  CsvTable t = parseCsv(readFile(path), path);
+// `expected` is the kind the caller reads ("an inputs.csv", "an errors.csv"): the other one,
+// given in its place (the two options swapped), is named as what it is.
+CsvTable readTable(const std::string& path, const char* expected, const char* option) {
+  const std::string text = readFile(path);
+  const std::string kind = describeContent(text);
+  for (const char* other : {"an inputs.csv", "an errors.csv", "a points CSV"})
+    if (kind.rfind(other, 0) == 0 && kind.rfind(expected, 0) != 0)
+      throw InputError(path, 0, std::string("this is ") + kind + "; " + option + " expects " + expected +
+                                    (std::string(expected) == "an inputs.csv"
+                                         ? " (time_s and the logged inputs: temperatures, speeds)"
+                                         : " (time_s, cycle and the evaluated errors with their U_ columns)"));
+  CsvTable t = parseCsv(text, path);
   if (t.header.empty()) throw InputError(path, 0, "no header line: expected time_s and the data columns");
   if (t.header[0] != "time_s")
     throw InputError(path, t.header_line, "the first column must be time_s, found '" + t.header[0] + "'");
@@ -55,7 +65,7 @@ std::string channelUnit(const std::string& channel) {
 }
 
 InputSeries loadInputs(const std::string& path) {
-  const CsvTable t = readTable(path);
+  const CsvTable t = readTable(path, "an inputs.csv", "--inputs");
   InputSeries s;
   s.file = path;
   s.names.assign(t.header.begin() + 1, t.header.end());
@@ -83,7 +93,7 @@ InputSeries loadInputs(const std::string& path) {
 }
 
 ErrorSeries loadErrors(const std::string& path) {
-  const CsvTable t = readTable(path);
+  const CsvTable t = readTable(path, "an errors.csv", "--errors");
   ErrorSeries s;
   s.file = path;
   std::vector<int> value_col, u_col;

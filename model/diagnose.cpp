@@ -8,6 +8,7 @@
 
 #include "core/csv.hpp"
 #include "core/error.hpp"
+#include "model/outputs.hpp"
 
 namespace probeloop::model {
 namespace {
@@ -173,6 +174,7 @@ void ljungBox(const std::vector<double>& x, int h, double& Q, double& p) {
 }
 
 Diagnosis diagnose(const Campaign& c, const ErrorModel& m, const DiagnoseOptions& opt) {
+  requireDistinctChannels(c, m);
   Diagnosis d;
   const int N = c.errors.size();
   const int n = trainingEnd(N, m.training_fraction);

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "core/csv.hpp"
+#include "core/error.hpp"
 
 namespace probeloop::model {
 namespace {
@@ -64,7 +65,21 @@ std::string indicatorRow(const std::string& label, const Indicators& i, const st
 
 }  // namespace
 
+void requireDistinctChannels(const Campaign& c, const ErrorModel& m) {
+  for (std::size_t i = 0; i < m.channels.size(); ++i)
+    for (std::size_t k = 0; k < i; ++k) {
+      const int a = c.errors.channel(m.channels[k].channel), b = c.errors.channel(m.channels[i].channel);
+      if (a >= 0 && a == b)
+        throw InputError(m.file, 0, "channels '" + m.channels[k].channel + "' and '" + m.channels[i].channel +
+                                        "' are the same column of " + c.errors.file + " (" +
+                                        c.errors.channels[static_cast<std::size_t>(a)] +
+                                        "): a channel is fitted once; merge their effects under " +
+                                        c.errors.channels[static_cast<std::size_t>(a)]);
+    }
+}
+
 ModelFit fitModel(const Campaign& c, const ErrorModel& m, double training_fraction) {
+  requireDistinctChannels(c, m);
   ModelFit f;
   f.train_end = trainingEnd(c.errors.size(), training_fraction > 0 ? training_fraction : m.training_fraction);
   for (const auto& ch : m.channels) f.after.push_back(fitChannel(c, ch.channel, ch.effects, f.train_end));

@@ -18,6 +18,9 @@ struct ModelFit {  // a whole model fitted on a campaign; `before` is empty when
 };
 
 // training_fraction > 0 overrides the model's (compare uses one split for all models).
+// Two model channels that name one errors.csv column ("EY0C" and "EY0C_um") would be fitted
+// twice with two verdicts: refused (InputError naming both and the column). fitModel checks it.
+void requireDistinctChannels(const Campaign& c, const ErrorModel& m);
 ModelFit fitModel(const Campaign& c, const ErrorModel& m, double training_fraction = 0);
 
 std::string fitText(const Campaign& c, const ErrorModel& m, const ModelFit& f);

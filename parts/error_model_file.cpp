@@ -1,10 +1,15 @@
 #include "parts/error_model_file.hpp"
 
+#include <map>
+#include <optional>
+#include <regex>
 #include <sstream>
+#include <vector>
 
 #include "core/atomic_file.hpp"
 #include "core/csv.hpp"
 #include "core/error.hpp"
+#include "core/input_file.hpp"
 #include "parts/yaml_reader.hpp"
 
 namespace probeloop::parts {
@@ -56,8 +61,10 @@ std::string quoted(const std::string& v) {
 
 }  // namespace
 
-model::ErrorModel loadErrorModel(const std::string& path) {
-  const YAML::Node root_node = loadYamlFile(path);
+model::ErrorModel loadErrorModel(const std::string& path) { return errorModelFromText(readFile(path, kYamlInput), path); }
+
+model::ErrorModel errorModelFromText(const std::string& text, const std::string& path) {
+  const YAML::Node root_node = loadYamlText(text, path);
   YamlMap root(root_node, path, "");
   if (root.string("kind") != "error_model") root.fail("kind", "expected 'error_model'");
   model::ErrorModel m;
@@ -132,5 +139,135 @@ std::string errorModelYaml(const model::ErrorModel& m) {
 }
 
 void saveErrorModel(const model::ErrorModel& m, const std::string& path) { writeFileAtomic(path, errorModelYaml(m)); }
+
+namespace {
+
+std::vector<std::string> splitLines(const std::string& text) {
+  std::vector<std::string> lines;
+  std::size_t b = 0;
+  while (b < text.size()) {
+    const std::size_t e = text.find('\n', b);
+    lines.push_back(text.substr(b, e == std::string::npos ? std::string::npos : e - b));
+    if (e == std::string::npos) break;
+    b = e + 1;
+  }
+  return lines;
+}
+
+std::size_t indentOf(const std::string& line) { return line.find_first_not_of(' '); }
+bool isContent(const std::string& line) {
+  const auto i = line.find_first_not_of(" \t\r");
+  return i != std::string::npos && line[i] != '#';
+}
+
+// The canonical one-line form of an effect (as errorModelYaml writes it, without the indent).
+std::string effectLine(const Effect& e) {
+  model::ErrorModel one;
+  one.channels.push_back({"c", {e}});
+  const std::string y = errorModelYaml(one);
+  const auto b = y.find("- {");
+  return y.substr(b, y.find('\n', b) - b);
+}
+
+// The last line (index) of the block that starts at `key`: the last content line indented more.
+std::size_t blockEnd(const std::vector<std::string>& lines, std::size_t key) {
+  const std::size_t ind = indentOf(lines[key]);
+  std::size_t last = key;
+  for (std::size_t i = key + 1; i < lines.size(); ++i) {
+    if (!isContent(lines[i])) continue;
+    if (indentOf(lines[i]) <= ind) break;
+    last = i;
+  }
+  return last;
+}
+
+}  // namespace
+
+std::optional<std::string> patchErrorModelText(const std::string& text, const model::ErrorModel& updated) {
+  const model::ErrorModel old = errorModelFromText(text, updated.file);
+  if (old.inputs_path != updated.inputs_path || old.errors_path != updated.errors_path ||
+      old.training_fraction != updated.training_fraction)
+    return std::nullopt;
+  const YAML::Node root = YAML::Load(text);
+  std::vector<std::string> lines = splitLines(text);
+  const YAML::Node chans = root["channels"];
+  if (!chans.IsMap() || chans.Style() == YAML::EmitterStyle::Flow) return std::nullopt;
+  std::map<std::size_t, std::vector<std::string>> insert_after;  // line index -> lines
+  std::size_t channels_end = 0, channel_indent = std::string::npos;
+  for (const auto& kv : chans) {
+    const std::string name = kv.first.as<std::string>();
+    const std::size_t key = static_cast<std::size_t>(kv.first.Mark().line);
+    if (key >= lines.size()) return std::nullopt;
+    channel_indent = indentOf(lines[key]);
+    channels_end = std::max(channels_end, blockEnd(lines, key));
+    const model::ChannelModel* was = old.channel(name);
+    const model::ChannelModel* now = updated.channel(name);
+    if (!was || !now || now->effects.size() < was->effects.size()) return std::nullopt;
+    const YAML::Node list = kv.second;
+    // just_added cleared on effects that had it: only in a flow map on one line.
+    for (std::size_t k = 0; k < was->effects.size(); ++k) {
+      if (was->effects[k].id() != now->effects[k].id()) return std::nullopt;
+      if (was->effects[k].just_added == now->effects[k].just_added) continue;
+      if (now->effects[k].just_added || list[k].Style() != YAML::EmitterStyle::Flow) return std::nullopt;
+      std::string& line = lines[static_cast<std::size_t>(list[k].Mark().line)];
+      static const std::regex flag(R"(,\s*just_added\s*:\s*true\b|\bjust_added\s*:\s*true\s*,\s*)");
+      const std::string cleared = std::regex_replace(line, flag, "", std::regex_constants::format_first_only);
+      if (cleared == line) return std::nullopt;
+      line = cleared;
+    }
+    if (now->effects.size() == was->effects.size()) continue;
+    std::string items;
+    for (std::size_t k = was->effects.size(); k < now->effects.size(); ++k)
+      items += (items.empty() ? "" : ", ") + effectLine(now->effects[k]).substr(2);
+    if (list.IsSequence() && list.Style() == YAML::EmitterStyle::Flow) {
+      // `EY0C_um: [{...}]  # comment` on the key line: the new maps go before its last ']'.
+      std::string& k = lines[key];
+      static const std::regex comment(R"(\s#)");
+      std::smatch c;
+      const std::size_t code_end = std::regex_search(k, c, comment) ? static_cast<std::size_t>(c.position(0)) : k.size();
+      const std::size_t close = k.rfind(']', code_end);
+      if (close == std::string::npos || k.find('[') > close) return std::nullopt;
+      k.insert(close, (list.size() == 0 ? "" : ", ") + items);
+      continue;
+    }
+    // A block list: the new effects go after the channel's last item, indented like its first.
+    std::string indent;
+    if (list.IsSequence() && list.size() > 0) {
+      const std::string& first = lines[static_cast<std::size_t>(list[0].Mark().line)];
+      const auto dash = first.find('-');
+      if (dash == std::string::npos) return std::nullopt;
+      indent = first.substr(0, dash);
+    } else {
+      indent = std::string(indentOf(lines[key]) + 2, ' ');  // `EX0C_um:` with nothing after it
+    }
+    auto& add = insert_after[blockEnd(lines, key)];
+    for (std::size_t k = was->effects.size(); k < now->effects.size(); ++k)
+      add.push_back(indent + effectLine(now->effects[k]));
+  }
+  // New channels go after the last one.
+  for (const auto& c : updated.channels) {
+    if (old.channel(c.channel)) continue;
+    if (channel_indent == std::string::npos) return std::nullopt;
+    auto& add = insert_after[channels_end];
+    const std::string ind(channel_indent, ' ');
+    add.push_back(ind + quoted(c.channel) + (c.effects.empty() ? ": []" : ":"));
+    for (const auto& e : c.effects) add.push_back(ind + "  " + effectLine(e));
+  }
+  std::string out;
+  for (std::size_t i = 0; i < lines.size(); ++i) {
+    out += lines[i] + "\n";
+    if (auto it = insert_after.find(i); it != insert_after.end())
+      for (const auto& l : it->second) out += l + "\n";
+  }
+  if (!text.empty() && text.back() != '\n') out.pop_back();
+  // The patch must mean exactly the updated model; otherwise the caller writes the canonical form.
+  try {
+    model::ErrorModel check = errorModelFromText(out, updated.file);
+    if (errorModelYaml(check) != errorModelYaml(updated)) return std::nullopt;
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+  return out;
+}
 
 }  // namespace probeloop::parts

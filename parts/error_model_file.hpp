@@ -15,8 +15,16 @@
 // Contract: loadErrorModel throws InputError with file:line for an unknown kind, key or
 // effect, a missing input, a non-positive tau/alpha/length, a channel listed twice, the
 // same effect twice in a channel. saveErrorModel writes the canonical form atomically
-// (comments are not kept; `probeloop model add` says so).
+// (comments are not kept).
+//
+// patchErrorModelText edits the file's own text instead (what `probeloop model add` uses, so
+// a user's comments and layout survive): effects appended after a channel's last item,
+// channels after the last one, `just_added: true` dropped where it was cleared. It returns
+// nothing when the layout is one it does not edit (flow-style channels, block-style effect
+// maps with a cleared flag) or when the edited text, parsed again, would not be exactly the
+// updated model; the caller then writes the canonical form and says so.
 #pragma once
+#include <optional>
 #include <string>
 
 #include "model/error_model.hpp"
@@ -24,6 +32,8 @@
 namespace probeloop::parts {
 
 model::ErrorModel loadErrorModel(const std::string& path);
+model::ErrorModel errorModelFromText(const std::string& text, const std::string& path);
+std::optional<std::string> patchErrorModelText(const std::string& text, const model::ErrorModel& updated);
 void saveErrorModel(const model::ErrorModel& m, const std::string& path);
 std::string errorModelYaml(const model::ErrorModel& m);
 

@@ -86,3 +86,47 @@ TEST(ErrorModelFile, RefusesBadFilesWithTheirLine) {
                 .find("only a static or lag effect acts over a lever"),
             std::string::npos);
 }
+
+// `model add` edits the user's text: comments and layout stay, the edit means exactly the
+// updated model, and a layout it does not edit in place is left to the canonical form.
+TEST(ErrorModelFile, PatchKeepsCommentsAndMeansTheUpdatedModel) {
+  const std::string text =
+      "# my model\n"
+      "kind: error_model   # always\n"
+      "channels:\n"
+      "  EX0C_um: [{effect: static, input: T_table_C, just_added: true}]  # first [guess]\n"
+      "  EY0C_um:\n"
+      "    - {effect: static, input: T_caxis_C}\n"
+      "\n"
+      "  # the radius: offset only\n"
+      "  ER0T_um: []\n";
+  auto m = parts::errorModelFromText(text, "m.yaml");
+  m.channels[0].effects[0].just_added = false;
+  model::Effect lag = model::makeEffect(model::EffectKind::Lag, "T_env_C");
+  lag.just_added = true;
+  m.channels[0].effects.push_back(lag);
+  m.channels[1].effects.push_back(lag);
+  m.channels[2].effects.push_back(lag);
+  m.channels.push_back({"EZ0T_um", {lag}});
+  const auto out = parts::patchErrorModelText(text, m);
+  ASSERT_TRUE(out.has_value());
+  EXPECT_EQ(*out,
+            "# my model\n"
+            "kind: error_model   # always\n"
+            "channels:\n"
+            "  EX0C_um: [{effect: static, input: T_table_C}, {effect: lag, input: \"T_env_C\", just_added: true}]  # first [guess]\n"
+            "  EY0C_um:\n"
+            "    - {effect: static, input: T_caxis_C}\n"
+            "    - {effect: lag, input: \"T_env_C\", just_added: true}\n"
+            "\n"
+            "  # the radius: offset only\n"
+            "  ER0T_um: [{effect: lag, input: \"T_env_C\", just_added: true}]\n"
+            "  \"EZ0T_um\":\n"
+            "    - {effect: lag, input: \"T_env_C\", just_added: true}\n");
+  EXPECT_EQ(parts::errorModelYaml(parts::errorModelFromText(*out, "m.yaml")), parts::errorModelYaml(m));
+  // A flow-style channels map is not edited in place: the caller writes the canonical form.
+  const std::string flow = "kind: error_model\nchannels: {EX0C_um: []}\n";
+  auto f = parts::errorModelFromText(flow, "f.yaml");
+  f.channels[0].effects.push_back(lag);
+  EXPECT_FALSE(parts::patchErrorModelText(flow, f).has_value());
+}

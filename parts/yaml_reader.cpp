@@ -68,6 +68,12 @@ YAML::Node loadYamlText(const std::string& text, const std::string& path) {
     if (!kind.empty() && kind.find("YAML") == std::string::npos) hint = " (the file looks like " + kind + ", not YAML)";
     throw InputError(path, e.mark.line + 1, "YAML syntax: " + e.msg + hint);
   }
+  // Every probeloop description is a mapping; a CSV or a log often parses as a YAML scalar.
+  if (!doc.IsMap()) {
+    const std::string kind = describeContent(text);
+    if (!kind.empty() && kind.find("YAML") == std::string::npos)
+      throw InputError(path, 0, "this is " + kind + ", not a YAML description (a mapping with kind: ...)");
+  }
   KeyCheck(path).walk(doc, 0);
   return doc;
 }

@@ -67,18 +67,18 @@ echo "   $(grep -c '^[0-9]' "$C/eval/errors.csv") cycles, inputs every 60 s: $C/
 export PATH="$PWD/build/cli:$PATH"   # the printed commands start with 'probeloop'
 for round in 1 2; do
   echo "-- diagnose (round $round): where the model fails, what is missing --"
-  probeloop model diagnose "$C/model.yaml" --part "$C/artifact.yaml" --report "$C/diagnosis-$round.html" > "$C/diagnosis-$round.txt"
+  probeloop model diagnose "$C/model.yaml" --part "$C/artifact.yaml" --html "$C/diagnosis-$round.html" > "$C/diagnosis-$round.txt"
   sed -n '/^  channel/,/^$/p' "$C/diagnosis-$round.txt" | grep -v '|residual|' | sed 's/^/   /'
   sed -n '/^1\. /,/add it:/p' "$C/diagnosis-$round.txt" | sed 's/^/   /'
   cmd=$(sed -n 's/^   add it: //p' "$C/diagnosis-$round.txt" | head -1)
   [ -n "$cmd" ] || { grep -v '^ ' "$C/diagnosis-$round.txt" | tail -1; break; }
   echo "-- add it, as printed: $cmd"
   eval "$cmd" >/dev/null
-  probeloop model fit "$C/model.yaml" --report "$C/fit-$round.html" --json "$C/fit-$round.json" > "$C/fit-$round.txt"
+  probeloop model fit "$C/model.yaml" --html "$C/fit-$round.html" > "$C/fit-$round.txt"
   sed -n '/^Before -> after/,$p' "$C/fit-$round.txt" | sed 's/^/   /'
 done
 echo "-- diagnose (final) --"
-probeloop model diagnose "$C/model.yaml" --part "$C/artifact.yaml" --report "$C/diagnosis-final.html" |
+probeloop model diagnose "$C/model.yaml" --part "$C/artifact.yaml" --html "$C/diagnosis-final.html" |
   grep -v '^Wrote' | grep . | tail -1 | fold -s -w 100 | sed 's/^/   /'
 echo "-- TALC replay (seed 004 Ch. 6) on the same campaign, a 36 h calibration phase (it holds the door event at 30 h) --"
 probeloop model talc --inputs "$C/run/inputs.csv" --errors "$C/eval/errors.csv" --cp-h 36 | sed -n '5,8p' | sed 's/^/   /'
@@ -142,7 +142,7 @@ sed -n '/^1\. /,/add it:/p' "$T/diagnosis.txt" | sed 's/^/   /'
 cmd=$(sed -n 's/^   add it: //p' "$T/diagnosis.txt" | head -1)
 echo "-- add it, as printed: $cmd"
 eval "$cmd" > /dev/null
-probeloop model fit "$T/model.yaml" --report "$T/fit.html" > "$T/fit.txt"
+probeloop model fit "$T/model.yaml" --html "$T/fit.html" > "$T/fit.txt"
 sed -n '/^Before -> after/,$p' "$T/fit.txt" | grep -E 'Before|channel|ETTP' | sed 's/^/   /'
 
 echo "== 8. the stepped workpiece (seed 000): the programs of W8, each step's Temp state, W8 on the virtual VMC, the separation =="

@@ -76,8 +76,9 @@ def main():
         for seed in range(1, a.diagnosis_seeds + 1):
             d = run(work, path, plan, seed, (("cmm", "cmm_export.csv"),))
             open(f"{d}/model.yaml", "w").write(MODEL)
-            pl("model", "diagnose", "model.yaml", "--part", path, "--json", "diag.json", cwd=d)
-            top = json.load(open(f"{d}/diag.json"))["candidates"][0]
+            diag = subprocess.run([PL, "model", "diagnose", "model.yaml", "--part", path, "--json"],
+                                  check=True, capture_output=True, text=True, cwd=d).stdout
+            top = json.loads(diag)["candidates"][0]
             on = "on E_TTP" if "ETTP_um" in [c["channel"] for c in top["channels"]] else "not on E_TTP"
             tops[(on, top["id"])] += 1
         print(f"  {name}: " + ", ".join(f"{n} x {i} ({on})" for (on, i), n in tops.most_common()))

@@ -67,7 +67,7 @@ with open(f"{W}/export/errors.csv") as f:
 d = sorted(b - a for a, b in zip(t, t[1:]))
 grid = repr(d[len(d) // 2])  # the replay's grid: the median spacing
 p = run("campaign", "run", A, "--finished", "--requested-only", "--grid-s", grid, *TALC,
-        "--dashboard", f"{W}/dash.html", "--controller-file", f"{W}/controller.json")
+        "--html", f"{W}/dash.html", "--controller-file", f"{W}/controller.json")
 check("campaign run (requested only)", p.returncode == 0, p.stderr)
 live = p.stdout
 p = run("model", "talc", "--inputs", f"{W}/export/inputs.csv", "--errors", f"{W}/export/errors.csv", *TALC)

@@ -17,3 +17,26 @@ class Checks:
     def finish(self):
         print(f"{self.passed} passed, {self.failed} failed")
         raise SystemExit(1 if self.failed else 0)
+
+
+def run_text_and_json(pl, args, cwd=None):
+    """Runs `pl *args`; when args hold `--json PATH`, runs the command twice: once for its
+    text (returned) and once with the `--json` flag, whose stdout goes to PATH (the CLI's
+    convention: --json prints JSON instead of the text). Returns (returncode, text, stderr)."""
+    import subprocess
+    args = list(args)
+    path = None
+    if "--json" in args:
+        i = args.index("--json")
+        if i + 1 < len(args) and not args[i + 1].startswith("-"):
+            path = args.pop(i + 1)
+            args.pop(i)
+    p = subprocess.run([pl, *args], capture_output=True, text=True, cwd=cwd)
+    if path is None or p.returncode != 0:
+        return p.returncode, p.stdout, p.stderr
+    q = subprocess.run([pl, *args, "--json"], capture_output=True, text=True, cwd=cwd)
+    if q.returncode == 0:
+        import os
+        with open(os.path.join(cwd or ".", path), "w") as f:
+            f.write(q.stdout)
+    return q.returncode, p.stdout, p.stderr + q.stderr

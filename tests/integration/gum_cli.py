@@ -8,7 +8,7 @@ Needs $PROBELOOP and $PROBELOOP_SOURCE_DIR; plain python3.
 import json, os, subprocess, sys, tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from checks import Checks  # noqa: E402
+from checks import Checks, run_text_and_json  # noqa: E402
 
 PL = os.environ["PROBELOOP"]
 SRC = os.environ["PROBELOOP_SOURCE_DIR"]
@@ -23,8 +23,9 @@ def gum(model, *args):
     out = os.path.join(W, "out.json")
     if os.path.exists(out):
         os.remove(out)
-    p = subprocess.run([PL, "gum", model, "--json", out, *args], capture_output=True, text=True)
-    j = json.load(open(out)) if p.returncode == 0 else None
+    rc, text, err = run_text_and_json(PL, ["gum", model, "--json", out, *args])
+    p = subprocess.CompletedProcess([], rc, text, err)
+    j = json.load(open(out)) if rc == 0 else None
     return p, j
 
 
@@ -94,9 +95,9 @@ for name, text, needles in cases:
     f = os.path.join(W, "bad.yaml")
     open(f, "w").write(text)
     out = os.path.join(W, "bad.json")
-    p = subprocess.run([PL, "gum", f, "--json", out], capture_output=True, text=True)
+    p = subprocess.run([PL, "gum", f, "--json"], capture_output=True, text=True)
     msg = p.stderr + p.stdout
-    check("refuses: " + name, p.returncode != 0 and all(n in msg for n in needles) and not os.path.exists(out)
+    check("refuses: " + name, p.returncode != 0 and all(n in msg for n in needles) and not p.stdout
           and "bad.yaml" in msg, msg)
 
 check.finish()

@@ -12,7 +12,7 @@ HTML report opened in headless Chromium. Needs $PROBELOOP and $PROBELOOP_SOURCE_
 import csv, json, math, os, shlex, subprocess, sys, tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from checks import Checks  # noqa: E402
+from checks import Checks, run_text_and_json  # noqa: E402
 from html_render import check as render_check  # noqa: E402
 
 PL = os.environ["PROBELOOP"]
@@ -32,8 +32,7 @@ CAMPAIGNS = {
 
 
 def run(*args):
-    p = subprocess.run([PL, *args], capture_output=True, text=True)
-    return p.returncode, p.stdout, p.stderr
+    return run_text_and_json(PL, args)
 
 
 def write_model(path, effects, data=True):
@@ -190,13 +189,13 @@ if p.returncode == 0:
 # The HTML report of the last campaign with an added effect, opened in Chromium.
 out = f"{W}/door_step"
 if os.path.exists(f"{out}/model.yaml"):
-    rc, _, err = run("model", "fit", f"{out}/model.yaml", "--report", f"{out}/fit.html")
-    check("fit --report writes the HTML", rc == 0 and os.path.exists(f"{out}/fit.html"), err)
+    rc, _, err = run("model", "fit", f"{out}/model.yaml", "--html", f"{out}/fit.html")
+    check("fit --html writes the HTML", rc == 0 and os.path.exists(f"{out}/fit.html"), err)
     if rc == 0:
         ok, detail = render_check(f"{out}/fit.html", 2 * len(CHANNELS))
         check("the fit report's plots render in headless Chromium", ok, detail)
-    rc, _, err = run("model", "diagnose", f"{out}/model.yaml", "--report", f"{out}/diagnosis.html")
-    check("diagnose --report writes the HTML", rc == 0 and os.path.exists(f"{out}/diagnosis.html"), err)
+    rc, _, err = run("model", "diagnose", f"{out}/model.yaml", "--html", f"{out}/diagnosis.html")
+    check("diagnose --html writes the HTML", rc == 0 and os.path.exists(f"{out}/diagnosis.html"), err)
 
 # Bad input: clear messages, nothing written.
 b = f"{W}/bad"

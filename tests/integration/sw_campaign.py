@@ -27,7 +27,7 @@ the module's unit tests (model/thermal_stages_test.cpp) are.
 import csv, json, math, os, re, subprocess, sys, tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from checks import Checks  # noqa: E402
+from checks import Checks, run_text_and_json  # noqa: E402
 from sw_truth import SwTruth  # noqa: E402
 
 PL = os.environ["PROBELOOP"]
@@ -40,8 +40,7 @@ check = Checks()
 
 
 def run(*args, cwd=None):
-    p = subprocess.run([PL, *args], capture_output=True, text=True, cwd=cwd)
-    return p.returncode, p.stdout, p.stderr
+    return run_text_and_json(PL, args, cwd)
 
 
 def part(label, experiment, seed, extra=()):

@@ -18,7 +18,7 @@ the same programs, cycles and checks, less machine time).
 import json, math, os, re, shutil, subprocess, sys, tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from checks import Checks  # noqa: E402
+from checks import Checks, run_text_and_json  # noqa: E402
 from compare_ttp import QUANTITIES, coverage, rows as error_rows  # noqa: E402
 
 PL = os.environ["PROBELOOP"]
@@ -32,8 +32,7 @@ check = Checks()
 
 
 def run(*args, cwd=None):
-    p = subprocess.run([PL, *args], capture_output=True, text=True, cwd=cwd)
-    return p.returncode, p.stdout, p.stderr
+    return run_text_and_json(PL, args, cwd)
 
 
 def piece():

@@ -145,7 +145,7 @@ def main(argv=None):
     follow_out = open(os.path.join(work, "campaign_run.out"), "w")
     follower = subprocess.Popen([pl, "campaign", "run", store, "--log", log, "--inputs", inputs, "--follow",
                                  "--poll-s", "0.1", "--controller-file", controller,
-                                 "--dashboard", os.path.join(work, "dashboard.html")] + talc,
+                                 "--html", os.path.join(work, "dashboard.html")] + talc,
                                 stdout=follow_out, stderr=subprocess.STDOUT)
     t0 = time.monotonic()
     try:
