@@ -93,9 +93,13 @@ std::optional<double> sumU(const Row& a, const Row& b) {
   return *a.U + *b.U;
 }
 
+// A value ± U with the cycle and time it belongs to on a second line (markup, escaped).
 std::string atCycle(const Row& r, const std::optional<double>& reference) {
-  return std::string(r.cycle && r.cycle == reference ? " (reference cycle " : " (cycle ") + whole(r.cycle) + ", " +
-         hoursAt(r.time_s) + ")";
+  return tdHtml(esc(valueU(r.value, r.U)) + "<br><span class=\"at\">" +
+                    esc(std::string(r.cycle && r.cycle == reference ? "reference cycle " : "cycle ") + whole(r.cycle) +
+                        ", " + hoursAt(r.time_s)) +
+                    "</span>",
+                true);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -200,11 +204,9 @@ void summaryTable(Page& page, const std::vector<std::pair<const ErrorInfo*, json
       if (*r.value > *hi->value) hi = &r;
     }
     page.html += "<tr>" + th(std::string(e->label) + " (" + e->unit + ")") +
-                 td(valueU(first.value, first.U) + atCycle(first, ref), true) +
-                 td(valueU(last.value, last.U) + atCycle(last, ref), true) +
-                 td(valueU(*last.value - *first.value, sumU(first, last)), true) +
-                 td(valueU(lo->value, lo->U) + atCycle(*lo, ref), true) +
-                 td(valueU(hi->value, hi->U) + atCycle(*hi, ref), true) +
+                 atCycle(first, ref) + atCycle(last, ref) +
+                 td(valueU(*last.value - *first.value, sumU(first, last)), true) + atCycle(*lo, ref) +
+                 atCycle(*hi, ref) +
                  td(valueU(*hi->value - *lo->value, sumU(*hi, *lo)), true) + "</tr>\n";
   }
   page.html += "</tbody>\n</table>\n";
@@ -214,7 +216,8 @@ void cycleTable(Page& page, const json& eval) {
   const json& cycles = array(eval, "cycles");
   page.html += std::string("<details class=\"cycles\"") + (cycles.size() <= kOpenTableCycles ? " open" : "") +
                "><summary>Every cycle: value \u00b1 U (k = 2), " + std::to_string(cycles.size()) +
-               " cycles</summary>\n<table class=\"cycles\">\n<thead><tr>" + th("cycle", true) + th("t (h)", true);
+               " cycles</summary>\n<div class=\"wide\">\n<table class=\"cycles\">\n<thead><tr>" + th("cycle", true) +
+               th("t (h)", true);
   for (const auto& e : kErrors) page.html += th(std::string(e.label) + " \u00b1 U (" + e.unit + ")", true);
   page.html += "</tr></thead>\n<tbody>\n";
   for (const auto& c : cycles) {
@@ -226,7 +229,7 @@ void cycleTable(Page& page, const json& eval) {
     }
     page.html += "</tr>\n";
   }
-  page.html += "</tbody>\n</table>\n</details>\n";
+  page.html += "</tbody>\n</table>\n</div>\n</details>\n";
 }
 
 const json* budgetOf(const json& cycle, const ErrorInfo& e) {
@@ -472,7 +475,9 @@ std::string sphereCampaignReportHtml(const json& evaluation, const std::string* 
       "content=\"probeloop\">\n<title>" +
       esc(title) + "</title>\n<style>" + kStyle +
       "h4 { font-size: .95em; margin: 1.1em 0 .2em; font-weight: 600; }\n"
-      "details > summary { cursor: pointer; color: #1f5f9f; margin: .4em 0; }\n</style>\n</head>\n<body>\n";
+      "details > summary { cursor: pointer; color: #1f5f9f; margin: .4em 0; }\n"
+      "span.at { font-size: .85em; color: #666; }\n"
+      "div.wide { overflow-x: auto; }\ntable.cycles th, table.cycles td { padding: .2em .45em; }\n</style>\n</head>\n<body>\n";
   out += page.html;
   out += "<script>\n" + vega + "\n</script>\n<script>" + kRender + "</script>\n</body>\n</html>\n";
   return out;

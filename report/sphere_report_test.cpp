@@ -305,13 +305,15 @@ TEST_F(SphereReport, TablesSummaryCyclesBudgetsAndSchedule) {
   EXPECT_NE(html.find("6 evaluated, reference cycle 1, 1 incomplete; 8 planned"), std::string::npos);
   EXPECT_NE(html.find("<td>0:35 (h:mm), from 0.02 h to 0.60 h on the log&#39;s clock</td>"), std::string::npos);
   // Summary of EC0C (min -2 at cycle 3, max 4 at cycle 2): range 6 ± (6 + 6).
-  EXPECT_NE(html.find("<tr><th>EC0C (\u00b5rad)</th><td class=\"num\">0 (reference cycle 1, 0.02 h)</td>"
-                      "<td class=\"num\">2.0 \u00b1 6.0 (cycle 6, 0.60 h)</td><td class=\"num\">2.0 \u00b1 6.0</td>"
-                      "<td class=\"num\">-2.0 \u00b1 6.0 (cycle 3, 0.25 h)</td>"
-                      "<td class=\"num\">4.0 \u00b1 6.0 (cycle 2, 0.13 h)</td><td class=\"num\">6 \u00b1 12</td></tr>"),
+  EXPECT_NE(html.find("<tr><th>EC0C (\u00b5rad)</th><td class=\"num\">0<br><span class=\"at\">reference cycle 1, "
+                      "0.02 h</span></td><td class=\"num\">2.0 \u00b1 6.0<br><span class=\"at\">cycle 6, 0.60 h</span></td>"
+                      "<td class=\"num\">2.0 \u00b1 6.0</td><td class=\"num\">-2.0 \u00b1 6.0<br><span class=\"at\">cycle 3, "
+                      "0.25 h</span></td><td class=\"num\">4.0 \u00b1 6.0<br><span class=\"at\">cycle 2, 0.13 h</span></td>"
+                      "<td class=\"num\">6 \u00b1 12</td></tr>"),
             std::string::npos);
   // EX0C: last 2.5 ± 1.5 at cycle 6; last - first = 2.5 ± 1.5 (the reference's U is 0).
-  EXPECT_NE(html.find("<td class=\"num\">2.5 \u00b1 1.5 (cycle 6, 0.60 h)</td><td class=\"num\">2.5 \u00b1 1.5</td>"),
+  EXPECT_NE(html.find("<td class=\"num\">2.5 \u00b1 1.5<br><span class=\"at\">cycle 6, 0.60 h</span></td><td "
+                      "class=\"num\">2.5 \u00b1 1.5</td>"),
             std::string::npos);
   // Every cycle: cycle 4, t = 1320.9 s = 0.367 h, EZ0T = 3.0 ± 2.5.
   EXPECT_NE(html.find("<tr><td class=\"num\">4</td><td class=\"num\">0.367</td><td class=\"num\">1.5 \u00b1 1.5</td>"

@@ -3,7 +3,7 @@
 checks what it shows against the files it was made from, with html_render.py's machinery.
 
 Usage: sphere_report_check.py REPORT.html --evaluation EVAL.json [--inputs inputs.csv]
-                              [--manifest plan.json] [--scene HREF]
+                              [--manifest plan.json] [--scene HREF] [--plots N]
        (exit 0 when every check passes, 1 otherwise, 2 on bad usage)
 
 From another test:
@@ -280,7 +280,7 @@ def check_dom_content(dom, found, evaluation, manifest, scene):
     return ok, lines
 
 
-def check(path, evaluation, inputs=None, manifest=None, scene=None):
+def check(path, evaluation, inputs=None, manifest=None, scene=None, n_plots=None):
     """Static checks, then the page in headless Chromium; returns (ok, text)."""
     if not os.path.isfile(path):
         return False, f"FAIL no such file: {path}"
@@ -294,6 +294,9 @@ def check(path, evaluation, inputs=None, manifest=None, scene=None):
         with open(manifest, encoding="utf-8") as f:
             man = json.load(f)
     ok, lines, found = check_static(html, ev, inp)
+    if n_plots is not None and len(found) != n_plots:
+        ok = False
+        lines.append(f"FAIL {len(found)} plots, expected {n_plots}")
     try:
         dom, seconds, _ = render(path)
     except Exception as e:  # noqa: BLE001 - reported as a failure
@@ -307,7 +310,7 @@ def check(path, evaluation, inputs=None, manifest=None, scene=None):
 
 def main(argv):
     args = argv[1:]
-    path, opts = None, {"--evaluation": None, "--inputs": None, "--manifest": None, "--scene": None}
+    path, opts = None, {"--evaluation": None, "--inputs": None, "--manifest": None, "--scene": None, "--plots": None}
     try:
         while args:
             a = args.pop(0)
@@ -319,11 +322,12 @@ def main(argv):
                 raise ValueError(a)
     except (IndexError, ValueError):
         path = None
-    if path is None or opts["--evaluation"] is None:
+    if path is None or opts["--evaluation"] is None or not (opts["--plots"] or "0").isdigit():
         print("usage: sphere_report_check.py REPORT.html --evaluation EVAL.json [--inputs inputs.csv] "
-              "[--manifest plan.json] [--scene HREF]", file=sys.stderr)
+              "[--manifest plan.json] [--scene HREF] [--plots N]", file=sys.stderr)
         return 2
-    ok, text = check(path, opts["--evaluation"], opts["--inputs"], opts["--manifest"], opts["--scene"])
+    ok, text = check(path, opts["--evaluation"], opts["--inputs"], opts["--manifest"], opts["--scene"],
+                     int(opts["--plots"]) if opts["--plots"] else None)
     print(text, flush=True)
     return 0 if ok else 1
 

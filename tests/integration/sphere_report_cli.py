@@ -8,7 +8,7 @@ plan and the scene -> sphere_report_check.py: what the page shows in headless Ch
 the evaluation, inputs.csv and plan.json it was made from; the same inputs give the same bytes;
 the page without the optional inputs; refusals (a thermal test piece's evaluation and plan, an
 inputs file without time_s, an errors.csv given as inputs) with exit 1, the file and what was
-expected named, and the page written before left as it was. About 15 s.
+expected named, and the page written before left as it was. About 5 s.
 
 Needs $PROBELOOP and $PROBELOOP_SOURCE_DIR; chromium from scripts/setup.sh.
 """
@@ -66,7 +66,8 @@ try:
     code, out, err = run("report", "sphere", "--evaluation", ev, "--inputs", inputs, "--manifest", plan,
                          "--scene", f"{W}/eval/campaign.gltf", "--html", html)
     check("report sphere writes the page and says so", code == 0 and out.startswith(f"Wrote {html} "), out + err)
-    ok, text = report_check(html, ev, inputs=inputs, manifest=plan, scene="campaign.gltf")
+    # 11 plots: the 7 errors, then the simulator's inputs by unit: °C, rpm, mm/min, no unit.
+    ok, text = report_check(html, ev, inputs=inputs, manifest=plan, scene="campaign.gltf", n_plots=11)
     print("\n".join("     " + line for line in text.splitlines()))
     check("the page shows the errors with U, the inputs, the budgets and the schedule (Chromium)", ok)
     page = open(html, encoding="utf-8").read()
@@ -86,7 +87,7 @@ try:
           '<a href="../eval/campaign.gltf">' in open(f"{W}/pages/min.html", encoding="utf-8").read())
 
     # --- without the optional inputs: the seven errors, said what is missing -----------------
-    ok, text = report_check(f"{W}/pages/min.html", ev, scene="../eval/campaign.gltf")
+    ok, text = report_check(f"{W}/pages/min.html", ev, scene="../eval/campaign.gltf", n_plots=7)
     print("\n".join("     " + line for line in text.splitlines() if not line.startswith("ok   plot-")))
     check("without --inputs and --manifest: the seven error plots, no schedule (Chromium)", ok)
     minimal = open(f"{W}/pages/min.html", encoding="utf-8").read()
