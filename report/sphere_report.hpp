@@ -24,8 +24,9 @@
 //   cycles and the input samples), so the plots line up under each other.
 // - Plots (Vega 5 declarative specs, SVG), in this order: one per location error present
 //   (EX0C ... EC0C): data set "cycles" with rows {time_s, cycle, value, U}, an area mark
-//   "u_band" from value − U to value + U, a line "value_line" and a symbol mark "values" (one
-//   symbol per cycle), usermeta {kind: "error", error, label, unit}; then, with inputs, one
+//   "u_band" from value − U to value + U over its rows that have U (data set "cycles_U"), a line
+//   "value_line" and a symbol mark "values" (one symbol per cycle), usermeta {kind: "error",
+//   error, label, unit}; then, with inputs, one
 //   plot per unit group of the inputs' columns (°C first, then rpm, then the others in the
 //   file's order, columns without a unit last): data set "inputs" with rows {time_s, v0, v1,
 //   ...}, one line mark "input_k" per column, usermeta {kind: "inputs", group, unit, columns:
