@@ -1,6 +1,7 @@
 #include "cli/report_commands.hpp"
 
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -10,6 +11,7 @@
 #include "core/atomic_file.hpp"
 #include "core/error.hpp"
 #include "parts/plan_manifest.hpp"
+#include "report/sphere_report.hpp"
 #include "report/sw_report.hpp"
 #include "report/ttp_report.hpp"
 #include "report/ttp_scene.hpp"
@@ -83,6 +85,37 @@ int runStepped(const SwArgs& a) {
   return 0;
 }
 
+struct SphereArgs {
+  std::string evaluation, inputs, manifest, scene, html;
+};
+
+// The scene's path as the page links it: relative to the page's folder, '/' separated.
+std::string sceneHref(const std::string& scene, const std::string& html) {
+  namespace fs = std::filesystem;
+  const fs::path from = fs::weakly_canonical(fs::absolute(html)).parent_path();
+  const fs::path rel = fs::weakly_canonical(fs::absolute(scene)).lexically_relative(from);
+  return rel.empty() ? fs::path(scene).generic_string() : rel.generic_string();
+}
+
+int runSphere(const SphereArgs& a) {
+  const nlohmann::json evaluation = readJsonFile(a.evaluation);
+  std::optional<std::string> inputs;
+  if (!a.inputs.empty()) inputs = readFile(a.inputs);
+  std::optional<parts::PlanManifest> manifest;
+  if (!a.manifest.empty()) manifest = parts::readManifest(a.manifest);
+  report::SphereReportOptions o;
+  o.evaluation_file = a.evaluation;
+  o.inputs_file = a.inputs;
+  o.manifest_file = a.manifest;
+  if (!a.scene.empty()) o.scene_href = sceneHref(a.scene, a.html);
+  const std::string html = report::sphereCampaignReportHtml(evaluation, inputs ? &*inputs : nullptr,
+                                                            manifest ? &*manifest : nullptr, report::defaultVegaPath(), o);
+  writeFileAtomic(a.html, html);
+  std::printf("Wrote %s (sphere-campaign report: %s%s%s)\n", a.html.c_str(), a.evaluation.c_str(),
+              inputs ? (", inputs " + a.inputs).c_str() : "", manifest ? (", plan " + a.manifest).c_str() : "");
+  return 0;
+}
+
 }  // namespace
 
 std::function<int()> addReportCommands(CLI::App& app, CLI::App*& group) {
@@ -123,9 +156,24 @@ std::function<int()> addReportCommands(CLI::App& app, CLI::App*& group) {
       ->required()
       ->check(cli::inputFile());
   sw->add_option("--html", s->html, "write the HTML report to this file")->required();
-  return [a, ttp, s, sw]() -> int {
+  auto sp = std::make_shared<SphereArgs>();
+  auto* sph = group->add_subcommand(
+      "sphere", "Sphere-artifact campaign (seed 004 Ch. 5): the seven location errors of the C axis against time "
+                "with U bands, every cycle's values, the budgets, the schedule, the temperatures and loads (HTML)");
+  sph->add_option("--evaluation", sp->evaluation, "evaluation.json of `probeloop evaluate` (sphere artifact)")
+      ->required()
+      ->check(cli::inputFile());
+  sph->add_option("--inputs", sp->inputs, "the run's inputs.csv (time_s, temperatures, speeds): drawn on the errors' time axis")
+      ->check(cli::inputFile());
+  sph->add_option("--manifest", sp->manifest, "the campaign's plan.json: the machine, the artifact and the schedule")
+      ->check(cli::inputFile());
+  sph->add_option("--scene", sp->scene, "a glTF scene of the campaign (`evaluate --scene`) the page links to")
+      ->check(cli::inputFile());
+  sph->add_option("--html", sp->html, "write the HTML report to this file")->required();
+  return [a, ttp, s, sw, sp, sph]() -> int {
     if (*ttp) return runTtp(*a);
     if (*sw) return runStepped(*s);
+    if (*sph) return runSphere(*sp);
     return 2;
   };
 }

@@ -1,5 +1,5 @@
-// `probeloop report ttp`: argument parsing, reading and writing files only; the page and the
-// scene are made in report/ (ttp_report, ttp_scene).
+// `probeloop report ttp|stepped|sphere`: argument parsing, reading and writing files only; the
+// pages and the scene are made in report/ (ttp_report, ttp_scene, sw_report, sphere_report).
 #pragma once
 #include <CLI/CLI.hpp>
 #include <functional>

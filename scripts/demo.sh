@@ -2,8 +2,8 @@
 # The main job on the shipped examples: plan the sphere-artifact cycle for the thesis's
 # machine (seed 004), run the emitted program on the virtual machine (thermal network, C-axis
 # duty, day/night hall, probe physics, tool changes: examples/truth_campaign.yaml), evaluate
-# the controller log, compare with the injected truth, and write the glTF scene; machine a
-# block; fit and diagnose an error model on 72 h; then the thermal test piece of seed 004
+# the controller log, compare with the injected truth, and write the HTML report and the glTF
+# scene; machine a block; fit and diagnose an error model on 72 h; then the thermal test piece of seed 004
 # Ch. 7 from its description to E_X ... E_TTP with U, the R-test beside it and the model.
 # Outputs in out/demo/.
 set -euo pipefail
@@ -42,6 +42,9 @@ $PL evaluate "$OUT/run/dprnt.txt" --format fanuc --manifest "$OUT/plan/plan.json
   --out "$OUT/eval" --scene "$OUT/eval/campaign.gltf"
 echo "   Uncertainty budgets (out/demo/eval/report.md; every term in docs/uncertainty.md):"
 awk '/^## Range of U/{on=1; next} /^## /{on=0} on && NF' "$OUT/eval/report.md" | sed 's/^/   /'
+# The page: the seven errors against time with U bands, budgets, schedule, temperatures and loads.
+$PL report sphere --evaluation "$OUT/eval/evaluation.json" --inputs "$OUT/run/inputs.csv" --manifest "$OUT/plan/plan.json" \
+  --scene "$OUT/eval/campaign.gltf" --html "$OUT/eval/report.html" | sed 's/^Wrote /   wrote /'
 echo
 echo "== 4. compare with the injected truth (truth.json: what the simulator put in) =="
 python3 tests/integration/compare_errors.py "$OUT/eval/errors.csv" "$OUT/run/truth.json" 0 0 --coverage
@@ -64,6 +67,8 @@ $PL simulate "$C/plan/sphere_cycle.nc" --machine parts/machines/nmv5000.yaml --p
 $PL evaluate "$C/run/points.csv" --format csv --manifest "$C/plan/plan.json" --out "$C/eval" >/dev/null
 { echo "data: {inputs: run/inputs.csv, errors: eval/errors.csv}"; cat examples/model/start.yaml; } > "$C/model.yaml"
 echo "   $(grep -c '^[0-9]' "$C/eval/errors.csv") cycles, inputs every 60 s: $C/run/inputs.csv, $C/eval/errors.csv"
+$PL report sphere --evaluation "$C/eval/evaluation.json" --inputs "$C/run/inputs.csv" --manifest "$C/plan/plan.json" \
+  --html "$C/report.html" | sed 's/^Wrote /   wrote /'
 export PATH="$PWD/build/cli:$PATH"   # the printed commands start with 'probeloop'
 for round in 1 2; do
   echo "-- diagnose (round $round): where the model fails, what is missing --"
@@ -214,8 +219,8 @@ echo "   (the thesis's tables are reproduced by evaluate/stepped_separation_test
 
 echo
 echo "Outputs: $OUT/plan (G-code, manifest), $OUT/run (controller log, points.csv, inputs.csv, truth.json),"
-echo "         $OUT/eval (errors.csv, evaluation.json, report.md, campaign.gltf), $OUT/machining (cuts.json, cmm_export.csv),"
-echo "         $OUT/campaign (72 h: model.yaml, diagnosis-*.html, fit-*.html with the plots),"
+echo "         $OUT/eval (errors.csv, evaluation.json, report.md, report.html, campaign.gltf), $OUT/machining (cuts.json, cmm_export.csv),"
+echo "         $OUT/campaign (72 h: report.html, model.yaml, diagnosis-*.html, fit-*.html with the plots),"
 echo "         $OUT/ttp (thermal test piece: plan/ (with cmm_plan.qif, .dmi), run/ (cmm_results.qif, .dmo), cmm/ (results.qif) and om/ evaluations, report.html, cmm/test_piece.gltf, r-test/, fit.html),"
 echo "         $OUT/stepped (stepped workpiece W8: plan/ with the roughing, finishing, probing programs; run/ with cmm_export.csv, sw_probe.log; eval/ with compensation.json;
          plan-compensated/, run-compensated/, eval-compensated/ with before/after; report.html;
