@@ -388,7 +388,7 @@ std::string steppedWorkpieceReportHtml(const json& eval, const std::string& file
                "k = 2 (95 %).</p>\n";
   if (compensated != nullptr)
     page.html += "<p class=\"note\">Two parts of the same experiment side by side: the part cut plain (uncompensated, "
-                 "filled symbols, first in every table: the numbers `probeloop evaluate` printed for it) and the part "
+                 "filled symbols, first in every table: the numbers probeloop evaluate printed for it) and the part "
                  "cut again with its predicted errors taken out of the finishing path (compensated, open symbols; its "
                  "e_proc and e_splz are against what was commanded).</p>\n";
   page.html += "</header>\n<div id=\"vega-errors\" class=\"errors\" role=\"alert\"></div>\n<script>" + std::string(kErrorHook) +

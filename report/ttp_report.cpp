@@ -15,6 +15,30 @@ using nlohmann::json;
 using namespace web;
 using namespace ttp_detail;
 
+namespace {
+
+// Every table of the page's sections but the inputs (class "meta") in a scroll container, so
+// that a wide one (six quantities ± U, two routes) scrolls instead of running past the page.
+std::string wrapTables(const std::string& html) {
+  const std::string open = "<div class=\"table-wrap\">\n";
+  std::string out;
+  std::size_t pos = 0;
+  for (std::size_t t = html.find("<table", pos); t != std::string::npos; t = html.find("<table", pos)) {
+    const std::size_t end = html.find("</table>\n", t);
+    const bool wrapped = t >= open.size() && html.compare(t - open.size(), open.size(), open) == 0;
+    if (end == std::string::npos || wrapped || html.compare(t, 19, "<table class=\"meta\"") == 0) {
+      out += html.substr(pos, t + 6 - pos);
+      pos = t + 6;
+      continue;
+    }
+    out += html.substr(pos, t - pos) + open + html.substr(t, end + 9 - t) + "</div>\n";
+    pos = end + 9;
+  }
+  return out + html.substr(pos);
+}
+
+}  // namespace
+
 std::string thermalTestPieceReportHtml(const json& evaluation, const json* second_route,
                                        const std::string* r_test_errors_csv_text, const std::string& vega_js_path,
                                        const TtpReportOptions& options) {
@@ -163,7 +187,7 @@ std::string thermalTestPieceReportHtml(const json& evaluation, const json* secon
       "content=\"probeloop\">\n<title>" +
       esc(title) + "</title>\n<style>" + kStyle +
       kMarkStyle + "th.group { text-align: center; }\n</style>\n</head>\n<body>\n";
-  out += page.html;
+  out += wrapTables(page.html);
   out += "<script>\n" + vega + "\n</script>\n<script>" + kRender + "</script>\n</body>\n</html>\n";
   return out;
 }

@@ -215,6 +215,9 @@ TEST_F(TtpReport, TablesShowValuesSpansBudgetsAndFormulas) {
                                              {{"period_h", 4}, {"quantity", "EY_um"}, {"this", 1.6}, {"other", 27.3},
                                               {"reduction_percent", 94.14}}})}};
   const std::string html = thermalTestPieceReportHtml(cmm, nullptr, nullptr, vega_);
+  // Every table but the inputs' in a scroll container: a wide one scrolls, nothing is cut off.
+  EXPECT_EQ(count(html, "<div class=\"table-wrap\">\n<table"), count(html, "<table") - count(html, "<table class=\"meta\""));
+  EXPECT_GE(count(html, "<div class=\"table-wrap\">\n<table"), 5u);
   // Units in the column names.
   for (const char* h : {"E_X \u00b1 U (\u00b5m)", "E_B \u00b1 U (\u00b5rad)", "\u0394T \u00b1 U (K)",
                         "E_X span \u00b1 U (\u00b5m)", "E_TTP, Eq. 7.9 (\u00b5m)"})
