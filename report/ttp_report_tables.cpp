@@ -221,7 +221,7 @@ void budgetTable(Page& page, const Route& r) {
     rows += td(input.empty() ? kDash : input) + td(text(*largest, "type").empty() ? kDash : text(*largest, "type")) +
             td(text(*largest, "distribution").empty() ? kDash : text(*largest, "distribution")) +
             td(withUnit(sig(number(*largest, "u"), 2), unit), true) + td(sig(number(*largest, "dof"), 3), true) +
-            td(text(*largest, "basis").empty() ? kDash : text(*largest, "basis")) + "</tr>\n";
+            td(text(*largest, "basis").empty() ? kDash : readerSource(text(*largest, "basis"))) + "</tr>\n";
   }
   page.html += "<h3>" + esc(r.label) + ": largest budget contribution per quantity (last cycle that has it)</h3>\n";
   if (rows.empty()) {

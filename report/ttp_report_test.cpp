@@ -442,8 +442,12 @@ TEST_F(TtpReport, ReferencesAReaderCanFollow) {
                              {"formula", "alpha dT E"},
                              {"source", "seed 004 Eq. 7.6 (notes/seed004.md \u00a74.4, L2111)"},
                              {"features", "-"}});
+  // A budget line's basis as the evaluation writes it (evaluate/ttp_budget.cpp).
+  for (auto& c : cmm["cycles"])
+    for (auto& v : c["values"]) v["contributions"][1]["basis"] = "22 um/(m K) (seed 004 L2177): |dT| u(alpha) / alpha";
   const std::string csv = rTestCsv();
   const std::string html = thermalTestPieceReportHtml(cmm, nullptr, &csv, vega_);
+  EXPECT_NE(html.find("<td>22 um/(m K): |dT| u(alpha) / alpha</td>"), std::string::npos);
   EXPECT_EQ(html.find("notes/seed"), std::string::npos);
   EXPECT_EQ(html.find("notes \u00a7"), std::string::npos);
   EXPECT_EQ(html.find("seed 004"), std::string::npos) << html.substr(html.find("seed 004") - 300, 400);
