@@ -123,13 +123,25 @@ json routeRows(const json& eval, const std::string& quantity) {
   return rows;
 }
 
+// Eq. 7.9 is Eq. 7.3 halved, term by term, from the same four facet changes (parts::ttpErrors:
+// (dX1 + dX2 + dY1 + dY2) / 4 against / 2), so its U is half of E_TTP's. Only when the cycle's
+// values show exactly that relation (the gauge route's E_TTP is Eq. 7.9 itself): nothing invented.
+std::optional<double> eq79U(const json& cycle, double eq79_value) {
+  const json* v = findValue(cycle, "ETTP_um");
+  if (v == nullptr) return std::nullopt;
+  const auto e73 = number(*v, "value"), U73 = number(*v, "U");
+  if (!e73 || !U73 || std::abs(eq79_value - *e73 / 2) > 1e-9 * std::max(1.0, std::abs(*e73))) return std::nullopt;
+  return *U73 / 2;
+}
+
 json alsoRows(const json& eval, const char* key) {
   json rows = json::array();
   for (const auto& c : array(eval, "cycles")) {
     const auto t = number(c, "time_s");
     const auto v = number(object(c, "also"), key);
     if (!t || !v) continue;
-    rows.push_back({{"time_s", *t}, {"cycle", cycleNumber(c)}, {"value", *v}, {"U", nullptr}});
+    const auto U = std::string(key) == "ETTP_7_9_um" ? eq79U(c, *v) : std::nullopt;
+    rows.push_back({{"time_s", *t}, {"cycle", cycleNumber(c)}, {"value", *v}, {"U", U ? json(*U) : json(nullptr)}});
   }
   return rows;
 }

@@ -55,7 +55,9 @@ void checkEvaluation(const json& j, const std::string& file);
 const json* findValue(const json& cycle, const std::string& quantity);
 std::optional<double> referenceTime(const json& eval);
 json routeRows(const json& eval, const std::string& quantity);  // {time_s, cycle, value, U}
-json alsoRows(const json& eval, const char* key);
+json alsoRows(const json& eval, const char* key);  // {time_s, cycle, value, U}; U only for Eq. 7.9, see eq79U
+// U of E_TTP by Eq. 7.9 in a cycle: half of E_TTP's (Eq. 7.3) when the value is exactly half.
+std::optional<double> eq79U(const json& cycle, double eq79_value);
 // Quantities present in a route (id, unit field), known ones first in their order.
 std::vector<std::pair<std::string, std::string>> routeQuantities(const json& eval);
 std::string listText(const json& a);

@@ -166,8 +166,8 @@ std::string plotCaption(const Quantity& q, const RTest* r, const RTestChannel* c
   std::string c = std::string(q.label) + " of the test piece: points with error bars \u00b1U (k as in the budget)";
   const std::string id = q.id;
   if (id == "ETTP_um" && has_eq79)
-    c += "; open diamonds, dashed: the Eq. 7.9 form (the mean of the four one-sided changes, half of Eq. 7.3; no U "
-         "in the evaluation)";
+    c += "; open diamonds, dashed: the Eq. 7.9 form (the mean of the four one-sided changes, exactly half of Eq. 7.3 "
+         "from the same facets, so \u00b1 half its U)";
   if (id == "dT_K")
     c = "\u0394T of the test piece (Eq. 7.10 with E_TTP in its radial Eq. 7.9 form, from the evaluation's dT_K): "
         "points with error bars \u00b1U";

@@ -28,7 +28,7 @@ struct Also {
   const char* key;
   const char* title;
 };
-constexpr Also kAlso[] = {{"ETTP_7_9_um", "E_TTP, Eq. 7.9 (\u00b5m)"}};
+constexpr Also kAlso[] = {{"ETTP_7_9_um", "E_TTP, Eq. 7.9 \u00b1 U (\u00b5m)"}};
 constexpr Also kPrinted[] = {{"EX_printed_um", "E_X, Eq. 7.1 as printed (\u00b5m)"},
                              {"EY_printed_um", "E_Y, Eq. 7.2 as printed (\u00b5m)"}};
 
@@ -77,15 +77,18 @@ void cycleTable(Page& page, const Route& r, double t0_s) {
       }
   if (also.empty()) return;
   page.html += "<h3>" + esc(r.label) +
-               ": E_TTP by Eq. 7.9 beside it (the dial-gauge form, one-sided: half of Eq. 7.3; no U in "
-               "the evaluation)</h3>\n"
+               ": E_TTP by Eq. 7.9 beside it (the dial-gauge form, one-sided: exactly half of Eq. 7.3 from "
+               "the same facets, so U is half of E_TTP's)</h3>\n"
                "<table class=\"also\">\n<thead><tr>" +
                th("cycle", true) + th("t (h:mm)", true);
   for (const auto* a : also) page.html += th(a->title, true);
   page.html += "</tr></thead>\n<tbody>\n";
   for (const auto& c : cycles) {
     page.html += "<tr>" + td(whole(number(c, "cycle")), true) + td(cycleHours(c, t0_s), true);
-    for (const auto* a : also) page.html += td(twoDecimals(number(object(c, "also"), a->key)), true);
+    for (const auto* a : also) {
+      const auto v = number(object(c, "also"), a->key);
+      page.html += v ? tdValueU(v, eq79U(c, *v)) : td(kDash, true);
+    }
     page.html += "</tr>\n";
   }
   page.html += "</tbody>\n</table>\n";

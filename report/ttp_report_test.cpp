@@ -178,7 +178,8 @@ TEST_F(TtpReport, OnePlotPerQuantityWithTheEvaluationsValues) {
   const json ttp = spec(html, 5);
   ASSERT_TRUE(dataset(ttp, "route1_eq_7_9").is_object());
   EXPECT_EQ(dataset(ttp, "route1_eq_7_9")["values"][4]["value"], -4.0);
-  EXPECT_EQ(dataset(ttp, "route1_eq_7_9")["values"][4]["U"], nullptr);
+  // Eq. 7.9 is exactly half of Eq. 7.3 from the same facets: U is half of E_TTP's (2.0 / 2).
+  EXPECT_EQ(dataset(ttp, "route1_eq_7_9")["values"][4]["U"], 1.0);
   // Render-error contract, SVG.
   EXPECT_NE(html.find("<div id=\"vega-errors\" class=\"errors\" role=\"alert\"></div>"), std::string::npos);
   EXPECT_NE(html.find("renderer: 'svg'"), std::string::npos);
@@ -220,7 +221,7 @@ TEST_F(TtpReport, TablesShowValuesSpansBudgetsAndFormulas) {
   EXPECT_GE(count(html, "<div class=\"table-wrap\">\n<table"), 5u);
   // Units in the column names.
   for (const char* h : {"E_X \u00b1 U (\u00b5m)", "E_B \u00b1 U (\u00b5rad)", "\u0394T \u00b1 U (K)",
-                        "E_X span \u00b1 U (\u00b5m)", "E_TTP, Eq. 7.9 (\u00b5m)"})
+                        "E_X span \u00b1 U (\u00b5m)", "E_TTP, Eq. 7.9 \u00b1 U (\u00b5m)"})
     EXPECT_NE(html.find("<th class=\"num\">" + std::string(h) + "</th>"), std::string::npos) << h;
   // Cycle 4: hours:minutes since the reference cut, E_Y = 8.0 +- 1.5.
   EXPECT_NE(html.find("<td class=\"num\">4</td><td>warm-up</td><td class=\"num\">4:00</td><td class=\"num\">2.0 \u00b1 "
@@ -395,6 +396,12 @@ TEST_F(TtpReport, PrintedEquationsOnlyInTheNoteAndTheAppendix) {
   EXPECT_NE(note.find("E_X(t_i) = [ d_X2(t_i) \u2212 d_X2(t_0) \u2212 d_X1(t_i) \u2212 d_X1(t_0) ] / 2"), std::string::npos);
   EXPECT_NE(note.find("does not cancel"), std::string::npos);
   EXPECT_NE(note.find("-97.50 mm here"), std::string::npos);
+  // A value that is not half of Eq. 7.3 gets no U (not invented): cycle 2 altered.
+  json odd = evaluation("cmm");
+  odd["cycles"][2]["also"]["ETTP_7_9_um"] = -1.5;
+  const json rows79 = dataset(spec(thermalTestPieceReportHtml(odd, nullptr, nullptr, vega_), 5), "route1_eq_7_9")["values"];
+  EXPECT_TRUE(rows79[2]["U"].is_null());
+  EXPECT_EQ(rows79[3]["U"], 1.0);
   // E_TTP by Eq. 7.9 is a form of the thesis, not a misprint: it stays in the main tables.
   EXPECT_NE(between(html, "<section class=\"values\">", "</section>").find("E_TTP, Eq. 7.9"), std::string::npos);
 }
