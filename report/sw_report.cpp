@@ -118,6 +118,8 @@ json pointsSpec(const std::string& description, const std::string& x_title, cons
   }
   addLegend(spec, legend);
   spec["legends"][0]["labelLimit"] = 360;
+  // Two parts give eight entries: in one row they would widen the plot past the page.
+  if (legend.size() > 4) spec["legends"][0]["columns"] = 2;
   return spec;
 }
 

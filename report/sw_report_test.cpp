@@ -197,6 +197,7 @@ TEST_F(SwReport, PlainAndCompensatedPartsSideBySide) {
   EXPECT_EQ(epos["usermeta"]["series"][2]["label"], "compensated: e_pos_x");
   EXPECT_EQ(dataset(epos, "e_pos_x_um")["values"][0]["value"], 2.0);
   EXPECT_EQ(dataset(epos, "e_pos_x_um_compensated")["values"][0]["value"], 1.75);
+  EXPECT_EQ(epos["legends"][0]["columns"], 2);  // eight entries in two columns, not one row past the page
   // Before/after: before +- U from the plain part (2 x 0.8), after +- U from the compensated one.
   const json ba = spec(html, 4);
   ASSERT_TRUE(ba.is_object());
