@@ -21,7 +21,7 @@ using parts::readJsonFile;
 namespace {
 
 struct TtpArgs {
-  std::string evaluation, second, r_test, html, scene, manifest;
+  std::string evaluation, second, r_test, inputs, html, scene, manifest;
   double exaggeration = 1000;
   report::TtpReportOptions options;
 };
@@ -49,6 +49,10 @@ int runTtp(TtpArgs a) {
   a.options.evaluation_file = a.evaluation;
   a.options.second_file = a.second;
   a.options.r_test_file = a.r_test;
+  if (!a.inputs.empty()) {
+    a.options.inputs_csv_text = readFile(a.inputs);
+    a.options.inputs_file = a.inputs;
+  }
 
   // Both outputs are made in memory first: an error in either leaves no file written.
   std::string html, gltf;
@@ -62,8 +66,9 @@ int runTtp(TtpArgs a) {
 
   if (!a.html.empty()) {
     writeFileAtomic(a.html, html);
-    std::printf("Wrote %s (thermal-test-piece report: %s%s%s)\n", a.html.c_str(), a.evaluation.c_str(),
-                second ? (" and " + a.second).c_str() : "", r_test ? (", R-test " + a.r_test).c_str() : "");
+    std::printf("Wrote %s (thermal-test-piece report: %s%s%s%s)\n", a.html.c_str(), a.evaluation.c_str(),
+                second ? (" and " + a.second).c_str() : "", r_test ? (", R-test " + a.r_test).c_str() : "",
+                a.inputs.empty() ? "" : (", inputs " + a.inputs).c_str());
   }
   if (!a.scene.empty()) {
     writeFileAtomic(a.scene, gltf);
@@ -74,14 +79,18 @@ int runTtp(TtpArgs a) {
 }
 
 struct SwArgs {
-  std::string evaluation, html;
+  std::string evaluation, compensated, html;
 };
 
 int runStepped(const SwArgs& a) {
   const nlohmann::json evaluation = readJsonFile(a.evaluation);
-  const std::string html = report::steppedWorkpieceReportHtml(evaluation, a.evaluation);
+  std::optional<nlohmann::json> compensated;
+  if (!a.compensated.empty()) compensated = readJsonFile(a.compensated);
+  const std::string html = report::steppedWorkpieceReportHtml(evaluation, a.evaluation, report::defaultVegaPath(),
+                                                              compensated ? &*compensated : nullptr, a.compensated);
   writeFileAtomic(a.html, html);
-  std::printf("Wrote %s (stepped-workpiece report: %s)\n", a.html.c_str(), a.evaluation.c_str());
+  std::printf("Wrote %s (stepped-workpiece report: %s%s)\n", a.html.c_str(), a.evaluation.c_str(),
+              compensated ? (", compensated " + a.compensated).c_str() : "");
   return 0;
 }
 
@@ -132,6 +141,9 @@ std::function<int()> addReportCommands(CLI::App& app, CLI::App*& group) {
       ->check(cli::inputFile());
   ttp->add_option("--r-test", a->r_test, "errors.csv of an R-test (sphere cycle) on the same clock")
       ->check(cli::inputFile());
+  ttp->add_option("--inputs", a->inputs,
+                  "inputs.csv of the run (time_s, temperatures *_C, c_rpm): temperatures and C load against time")
+      ->check(cli::inputFile());
   ttp->add_option("--html", a->html, "write the HTML report to this file");
   auto* manifest = ttp->add_option("--manifest", a->manifest, "plan.json of the test piece (for --scene)")
                        ->check(cli::inputFile());
@@ -152,8 +164,14 @@ std::function<int()> addReportCommands(CLI::App& app, CLI::App*& group) {
   auto* sw = group->add_subcommand(
       "stepped", "Stepped workpiece (seed 000): the separated components with U against travel, feed and Temp state; "
                  "a compensated part's before/after per feature (HTML)");
-  sw->add_option("--evaluation", s->evaluation, "evaluation.json of `probeloop evaluate … --probe-log` (with --compare: before/after)")
+  sw->add_option("--evaluation", s->evaluation,
+                 "evaluation.json of `probeloop evaluate … --probe-log`: the part cut plain (or, alone, any part; "
+                 "one evaluated with --compare shows its before/after)")
       ->required()
+      ->check(cli::inputFile());
+  sw->add_option("--compensated", s->compensated,
+                 "evaluation.json of the same experiment cut compensated and evaluated with --compare against "
+                 "--evaluation: both parts side by side, before/after with U")
       ->check(cli::inputFile());
   sw->add_option("--html", s->html, "write the HTML report to this file")->required();
   auto sp = std::make_shared<SphereArgs>();

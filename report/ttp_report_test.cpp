@@ -6,6 +6,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
+#include <regex>
 #include <string>
 #include <vector>
 
@@ -176,7 +178,8 @@ TEST_F(TtpReport, OnePlotPerQuantityWithTheEvaluationsValues) {
   const json ttp = spec(html, 5);
   ASSERT_TRUE(dataset(ttp, "route1_eq_7_9").is_object());
   EXPECT_EQ(dataset(ttp, "route1_eq_7_9")["values"][4]["value"], -4.0);
-  EXPECT_EQ(dataset(ttp, "route1_eq_7_9")["values"][4]["U"], nullptr);
+  // Eq. 7.9 is exactly half of Eq. 7.3 from the same facets: U is half of E_TTP's (2.0 / 2).
+  EXPECT_EQ(dataset(ttp, "route1_eq_7_9")["values"][4]["U"], 1.0);
   // Render-error contract, SVG.
   EXPECT_NE(html.find("<div id=\"vega-errors\" class=\"errors\" role=\"alert\"></div>"), std::string::npos);
   EXPECT_NE(html.find("renderer: 'svg'"), std::string::npos);
@@ -213,17 +216,20 @@ TEST_F(TtpReport, TablesShowValuesSpansBudgetsAndFormulas) {
                                              {{"period_h", 4}, {"quantity", "EY_um"}, {"this", 1.6}, {"other", 27.3},
                                               {"reduction_percent", 94.14}}})}};
   const std::string html = thermalTestPieceReportHtml(cmm, nullptr, nullptr, vega_);
+  // Every table but the inputs' in a scroll container: a wide one scrolls, nothing is cut off.
+  EXPECT_EQ(count(html, "<div class=\"table-wrap\">\n<table"), count(html, "<table") - count(html, "<table class=\"meta\""));
+  EXPECT_GE(count(html, "<div class=\"table-wrap\">\n<table"), 5u);
   // Units in the column names.
   for (const char* h : {"E_X \u00b1 U (\u00b5m)", "E_B \u00b1 U (\u00b5rad)", "\u0394T \u00b1 U (K)",
-                        "E_X span \u00b1 U (\u00b5m)", "E_TTP, Eq. 7.9 (\u00b5m)", "E_X, Eq. 7.1 as printed (\u00b5m)"})
+                        "E_X span \u00b1 U (\u00b5m)", "E_TTP, Eq. 7.9 \u00b1 U (\u00b5m)"})
     EXPECT_NE(html.find("<th class=\"num\">" + std::string(h) + "</th>"), std::string::npos) << h;
-  // Cycle 4: hours since the reference cut, E_Y = 8.0 +- 1.5.
-  EXPECT_NE(html.find("<td class=\"num\">4</td><td>warm-up</td><td class=\"num\">4.00</td><td class=\"num\">2.0 \u00b1 "
+  // Cycle 4: hours:minutes since the reference cut, E_Y = 8.0 +- 1.5.
+  EXPECT_NE(html.find("<td class=\"num\">4</td><td>warm-up</td><td class=\"num\">4:00</td><td class=\"num\">2.0 \u00b1 "
                       "1.5</td><td class=\"num\">8.0 \u00b1 1.5</td>"),
             std::string::npos);
-  // Spans in Table 7.2's layout: one row per period.
-  EXPECT_NE(html.find("<tr><th>4 h (cycles 0\u20134)</th><td class=\"num\">2.0 \u00b1 2.1</td><td class=\"num\">8.0 "
-                      "\u00b1 2.8</td></tr>"),
+  // Spans in Table 7.2's layout: one row per period; E_X's span 2.0 is within its U 2.1: n.s.
+  EXPECT_NE(html.find("<tr><th>4:00 (cycles 0\u20134)</th><td class=\"num ns\">2.0 \u00b1 2.1 <span class=\"ns-mark\">"
+                      "n.s.</span></td><td class=\"num\">8.0 \u00b1 2.8</td></tr>"),
             std::string::npos);
   // Comparison with reductions.
   EXPECT_NE(html.find("uncompensated/evaluation.json"), std::string::npos);
@@ -237,7 +243,10 @@ TEST_F(TtpReport, TablesShowValuesSpansBudgetsAndFormulas) {
   EXPECT_NE(html.find("type A \u03c3 = 0.72 \u00b5m (\u03bd = 310), type B \u03c3 = 0.50 \u00b5m; used: type A"),
             std::string::npos);
   // Formulas with sources.
-  EXPECT_NE(html.find("<td>seed 004 Eq. 7.1 (sign corrected, notes \u00a711 item 10)</td>"), std::string::npos);
+  // Formulas with the thesis's section and equation, not the evaluation's notes reference.
+  EXPECT_NE(html.find("<td>Blaser 2020 (ETH Diss. 26709), Sec. 7.2, Eq. 7.1 (the sign of its last term corrected: see the "
+                      "note on Eqs. 7.1 and 7.2)</td>"),
+            std::string::npos);
 }
 
 TEST_F(TtpReport, RTestBesideTheRoutesWithSignAndTemperatureEquivalent) {
@@ -358,6 +367,154 @@ TEST_F(TtpReport, RefusesWhatIsNotAThermalTestPieceEvaluation) {
   EXPECT_THROW(thermalTestPieceReportHtml(cmm, nullptr, &not_errors, vega_), InputError);
   const std::string no_time = "cycle,EX0C_um\n1,0\n";
   EXPECT_THROW(thermalTestPieceReportHtml(cmm, nullptr, &no_time, vega_), InputError);
+}
+
+// The page between two markers (the first occurrence of each).
+std::string between(const std::string& html, const std::string& from, const std::string& to) {
+  const std::size_t a = html.find(from);
+  if (a == std::string::npos) return "";
+  const std::size_t b = html.find(to, a);
+  return html.substr(a, b == std::string::npos ? std::string::npos : b - a);
+}
+
+TEST_F(TtpReport, PrintedEquationsOnlyInTheNoteAndTheAppendix) {
+  json cmm = evaluation("cmm");
+  // Eq. 7.1 as printed keeps -d_X1(t0): about -97.5 mm on the shipped piece.
+  for (auto& c : cmm["cycles"]) c["also"]["EX_printed_um"] = -97498.95;
+  const std::string html = thermalTestPieceReportHtml(cmm, nullptr, nullptr, vega_);
+  const std::size_t appendix = html.find("<section class=\"appendix\" id=\"appendix-printed\">");
+  ASSERT_NE(appendix, std::string::npos);
+  // The main tables (values, spans, budgets, formulas) hold neither the value nor the column.
+  const std::string main_part = html.substr(0, appendix);
+  EXPECT_EQ(main_part.find("-97498.95"), std::string::npos);
+  EXPECT_EQ(main_part.find("as printed (\u00b5m)"), std::string::npos);
+  const std::string values = between(html, "<section class=\"values\">", "</section>");
+  EXPECT_EQ(values.find("printed"), std::string::npos) << values.substr(values.find("printed") - 200, 400);
+  // The appendix lists it per cycle; the note shows the printed equation and why it is wrong.
+  EXPECT_EQ(count(html.substr(appendix), "<td class=\"num\">-97498.95</td>"), 9u);
+  const std::string note = between(html, "<section class=\"printed-forms\">", "</section>");
+  EXPECT_NE(note.find("E_X(t_i) = [ d_X2(t_i) \u2212 d_X2(t_0) \u2212 d_X1(t_i) \u2212 d_X1(t_0) ] / 2"), std::string::npos);
+  EXPECT_NE(note.find("does not cancel"), std::string::npos);
+  EXPECT_NE(note.find("-97.50 mm here"), std::string::npos);
+  // A value that is not half of Eq. 7.3 gets no U (not invented): cycle 2 altered.
+  json odd = evaluation("cmm");
+  odd["cycles"][2]["also"]["ETTP_7_9_um"] = -1.5;
+  const json rows79 = dataset(spec(thermalTestPieceReportHtml(odd, nullptr, nullptr, vega_), 5), "route1_eq_7_9")["values"];
+  EXPECT_TRUE(rows79[2]["U"].is_null());
+  EXPECT_EQ(rows79[3]["U"], 1.0);
+  // E_TTP by Eq. 7.9 is a form of the thesis, not a misprint: it stays in the main tables.
+  EXPECT_NE(between(html, "<section class=\"values\">", "</section>").find("E_TTP, Eq. 7.9"), std::string::npos);
+}
+
+TEST_F(TtpReport, HoursAsHoursAndMinutes) {
+  EXPECT_EQ(web::hoursMinutes(3633.0), "1:01");
+  EXPECT_EQ(web::hoursMinutes(29100.0), "8:05");
+  EXPECT_EQ(web::hoursMinutes(1.00927 * 3600), "1:01");
+  EXPECT_EQ(web::hoursMinutes(-1800.0), "\u22120:30");
+  EXPECT_EQ(web::hoursMinutes(0.0), "0:00");
+  EXPECT_EQ(web::hoursMinutes(std::nullopt), web::kDash);
+  json cmm = evaluation("cmm");
+  cmm["spans"][0]["period_h"] = 1.00927;  // as the evaluation writes it: the cycles' real distance
+  const std::string html = thermalTestPieceReportHtml(cmm, nullptr, nullptr, vega_);
+  EXPECT_NE(html.find("<tr><th>1:01 (cycles 0\u20131)</th>"), std::string::npos);
+  EXPECT_EQ(html.find("1.00927"), std::string::npos);
+  EXPECT_NE(html.find("<td class=\"num\">8:00</td>"), std::string::npos);  // cycle 8
+  // The plots' time axis is labelled h:mm too.
+  EXPECT_EQ(spec(html, 1)["axes"][0]["title"], "time since the reference cut (h:mm)");
+  EXPECT_TRUE(spec(html, 1)["axes"][0]["encode"]["labels"]["update"]["text"].contains("signal"));
+}
+
+TEST_F(TtpReport, NotSignificantValuesAreMarked) {
+  json cmm = evaluation("cmm");
+  cmm["cycles"][1]["values"][3]["value"] = -2.0;  // E_B -2 +- 11 urad (the review's example)
+  cmm["cycles"][1]["values"][3]["U"] = 11.0;
+  const std::string html = thermalTestPieceReportHtml(cmm, nullptr, nullptr, vega_);
+  const std::string values = between(html, "<section class=\"values\">", "</section>");
+  EXPECT_NE(values.find("<td class=\"num ns\">-2 \u00b1 11 <span class=\"ns-mark\">n.s.</span></td>"), std::string::npos);
+  // Cycle 1's E_Y 2.0 +- 1.5 is significant: no class, no marker.
+  EXPECT_NE(values.find("<td class=\"num\">2.0 \u00b1 1.5</td>"), std::string::npos);
+  EXPECT_EQ(values.find("<td class=\"num ns\">2.0 \u00b1 1.5"), std::string::npos);
+  // The legend says what it means, and the style makes it grey.
+  EXPECT_NE(values.find("not significant, |value| \u2264 U (k = 2)"), std::string::npos);
+  EXPECT_NE(html.find("td.ns, .ns { color: #8a8a8a; }"), std::string::npos);
+  EXPECT_TRUE(web::notSignificant(-2.0, 11.0));
+  EXPECT_TRUE(web::notSignificant(11.0, 11.0));
+  EXPECT_FALSE(web::notSignificant(11.5, 11.0));
+  EXPECT_FALSE(web::notSignificant(1.0, std::nullopt));
+}
+
+TEST_F(TtpReport, ReferencesAReaderCanFollow) {
+  json cmm = evaluation("cmm");
+  cmm["formulas"].push_back({{"output", "EQ_um"},
+                             {"formula", "alpha dT E"},
+                             {"source", "seed 004 Eq. 7.6 (notes/seed004.md \u00a74.4, L2111)"},
+                             {"features", "-"}});
+  // A budget line's basis as the evaluation writes it (evaluate/ttp_budget.cpp).
+  for (auto& c : cmm["cycles"])
+    for (auto& v : c["values"]) v["contributions"][1]["basis"] = "22 um/(m K) (seed 004 L2177): |dT| u(alpha) / alpha";
+  const std::string csv = rTestCsv();
+  const std::string html = thermalTestPieceReportHtml(cmm, nullptr, &csv, vega_);
+  EXPECT_NE(html.find("<td>22 um/(m K): |dT| u(alpha) / alpha</td>"), std::string::npos);
+  EXPECT_EQ(html.find("notes/seed"), std::string::npos);
+  EXPECT_EQ(html.find("notes \u00a7"), std::string::npos);
+  EXPECT_EQ(html.find("seed 004"), std::string::npos) << html.substr(html.find("seed 004") - 300, 400);
+  const std::regex line_number(R"(\bL[0-9]{3,4}\b)");
+  EXPECT_FALSE(std::regex_search(html, line_number)) << "a source-file line number in the page";
+  EXPECT_NE(html.find("<td>Blaser 2020 (ETH Diss. 26709), Eq. 7.6</td>"), std::string::npos);
+  EXPECT_NE(html.find("Blaser 2020 (ETH Diss. 26709), Sec. 7.3, Eq. 7.10"), std::string::npos);
+}
+
+// inputs.csv as `probeloop simulate` writes it: a sample every 10 min from 1 h before the
+// reference cut to 1 h after the last cycle.
+std::string inputsCsv() {
+  std::string s = "# probeloop simulate: machine inputs\ntime_s,T_env_C,T_caxis_C,c_rpm,spindle_rpm,tool_changes\n";
+  for (int i = -6; i <= 54; ++i) {
+    const double t = kT0 + i * 600.0;
+    char row[256];
+    std::snprintf(row, sizeof row, "%.0f,%.2f,%.2f,%d,0,0\n", t, 20.0 + 0.01 * i, 21.0 + 0.1 * i, i >= 0 && i < 24 ? 1200 : 0);
+    s += row;
+  }
+  return s;
+}
+
+TEST_F(TtpReport, TemperaturesAndCLoadFromTheMachinesInputs) {
+  const json cmm = evaluation("cmm");
+  TtpReportOptions o;
+  o.inputs_csv_text = inputsCsv();
+  o.inputs_file = "run/inputs.csv";
+  const std::string html = thermalTestPieceReportHtml(cmm, nullptr, nullptr, vega_, o);
+  EXPECT_EQ(count(html, "class=\"vega-plot\""), 8u);  // 6 quantities, temperatures, C load
+  const json t = spec(html, 7), c = spec(html, 8);
+  ASSERT_TRUE(t.is_object());
+  ASSERT_TRUE(c.is_object());
+  EXPECT_EQ(t["usermeta"]["inputs"], "temperatures");
+  EXPECT_EQ(t["usermeta"]["series"][0]["column"], "T_env_C");
+  EXPECT_EQ(t["usermeta"]["series"][1]["column"], "T_caxis_C");
+  // Over the errors' hours (0 to 8 h): the samples from 0 h to 8 h and one beyond each end.
+  const json caxis = dataset(t, "temperature_2")["values"];
+  ASSERT_EQ(caxis.size(), 51u);
+  EXPECT_EQ(caxis[0]["time_s"], kT0 - 600.0);
+  EXPECT_DOUBLE_EQ(caxis[1]["value"].get<double>(), 21.0);
+  EXPECT_DOUBLE_EQ(caxis[7]["value"].get<double>(), 21.6);
+  EXPECT_EQ(t["scales"][0]["domain"], json::array({0.0, 8.0}));
+  EXPECT_EQ(c["usermeta"]["inputs"], "c_load");
+  const json rpm = dataset(c, "c_rpm")["values"];
+  EXPECT_EQ(rpm[1]["value"], 1200.0);
+  EXPECT_EQ(rpm[25]["value"], 0.0);
+  EXPECT_NE(c.dump().find("step-after"), std::string::npos);
+  EXPECT_NE(html.find("<td>run/inputs.csv: T_env_C (\u00b0C), T_caxis_C (\u00b0C), c_rpm (rpm)</td>"), std::string::npos);
+  // Without the inputs: no such plots.
+  EXPECT_EQ(count(thermalTestPieceReportHtml(cmm, nullptr, nullptr, vega_), "class=\"vega-plot\""), 6u);
+  // Inputs that are not a machine's log are refused, naming the file.
+  o.inputs_csv_text = "cycle,EX0C_um\n1,0\n";
+  EXPECT_THROW(thermalTestPieceReportHtml(cmm, nullptr, nullptr, vega_, o), InputError);
+  o.inputs_csv_text = "time_s,spindle_rpm\n0,0\n";
+  try {
+    thermalTestPieceReportHtml(cmm, nullptr, nullptr, vega_, o);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("run/inputs.csv"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(TtpReport, InlinesDebianVega) {

@@ -396,6 +396,48 @@ void Page::plot(const json& spec, const std::string& caption) {
           id + "-spec\">" + scriptJson(spec) + "</script>\n<figcaption>" + esc(caption) + "</figcaption>\n</figure>\n";
 }
 
+// ---------------------------------------------------------------------------------------
+// Significance and time.
+
+bool notSignificant(const std::optional<double>& value, const std::optional<double>& U) {
+  return value && U && std::isfinite(*value) && std::isfinite(*U) && *U > 0.0 && std::abs(*value) <= *U;
+}
+
+std::string tdValueU(const std::optional<double>& value, const std::optional<double>& U, const std::string& marker) {
+  if (!notSignificant(value, U)) return td(valueU(value, U), true);
+  return "<td class=\"num ns\">" + esc(valueU(value, U)) + " <span class=\"ns-mark\">" + esc(marker) + "</span></td>";
+}
+
+const char* const kNotSignificantNote =
+    "<p class=\"note ns-legend\"><span class=\"ns\">Grey, marked <span class=\"ns-mark\">n.s.</span></span>: "
+    "not significant, |value| \u2264 U (k = 2): the measurement cannot tell the value from zero.</p>";
+
+const char* const kMarkStyle = R"CSS(
+td.ns, .ns { color: #8a8a8a; }
+.ns-mark { font-size: .75em; font-style: italic; color: #8a8a8a; margin-left: .25em; }
+.table-wrap { max-width: 100%; overflow-x: auto; margin: .3em 0 1em; }
+.table-wrap > table { margin: 0; }
+)CSS";
+
+std::string tableWrap(const std::string& table_html) { return "<div class=\"table-wrap\">\n" + table_html + "</div>\n"; }
+
+std::string hoursMinutes(const std::optional<double>& seconds) {
+  if (!seconds || !std::isfinite(*seconds)) return kDash;
+  const long long minutes = std::llround(std::abs(*seconds) / 60.0);
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%lld:%02lld", minutes / 60, minutes % 60);
+  return (*seconds < 0 && minutes > 0 ? "\u2212" : "") + std::string(buf);
+}
+
+// Vega's expression language: the tick's value in hours as h:mm, as hoursMinutes() does.
+json hoursMinutesAxisLabels() {
+  const std::string m = "round(abs(datum.value) * 60)";
+  return {{"update",
+           {{"text",
+             {{"signal", "(datum.value < 0 && " + m + " > 0 ? '\u2212' : '') + floor(" + m + " / 60) + ':' + (" + m +
+                             " % 60 < 10 ? '0' : '') + (" + m + " % 60)"}}}}}};
+}
+
 std::string th(const std::string& s, bool num) {
   return std::string(num ? "<th class=\"num\">" : "<th>") + esc(s) + "</th>";
 }

@@ -82,6 +82,30 @@ class Page {
   void plot(const json& spec, const std::string& caption);
 };
 
+// ---- Significance and time, shared by every report (thermal test piece, stepped workpiece,
+// sphere campaign). Each page that uses them puts kMarkStyle in its <style>.
+//
+// A measured value is not significant when |value| <= U (U expanded, k = 2): the measurement
+// cannot tell it from zero. notSignificant() is false when either is missing or U <= 0.
+bool notSignificant(const std::optional<double>& value, const std::optional<double>& U);
+// A numeric table cell showing valueU(value, U). When notSignificant: <td class="num ns"> and
+// a trailing <span class="ns-mark">n.s.</span> (`marker` replaces "n.s.", e.g. "not resolved"
+// for an orientation; escaped). Put kNotSignificantNote (or your own sentence) once on the page.
+std::string tdValueU(const std::optional<double>& value, const std::optional<double>& U,
+                     const std::string& marker = "n.s.");
+extern const char* const kNotSignificantNote;  // <p class="note ns-legend">…</p>: what "n.s." means
+// CSS: .ns (grey), .ns-mark, and .table-wrap (a scroll container: a wide table scrolls
+// inside it instead of running past the page; wrap tables in tableWrap()).
+extern const char* const kMarkStyle;
+// `table_html` (a whole <table>…</table>) inside <div class="table-wrap">.
+std::string tableWrap(const std::string& table_html);
+// Seconds as hours and minutes, "h:mm", rounded to the minute: 3633 -> "1:01", 29100 ->
+// "8:05", -1800 -> "−0:30" (U+2212); "—" when missing or not finite.
+std::string hoursMinutes(const std::optional<double>& seconds);
+// The same format in a Vega axis: put {"labels", hoursMinutesAxisLabels()} in an axis's
+// "encode" when the axis's scale is in hours (ticks at whole or simple fractional hours).
+json hoursMinutesAxisLabels();
+
 std::string th(const std::string& s, bool num = false);
 std::string tdHtml(const std::string& html, bool num = false);  // `html` is already markup
 std::string td(const std::string& s, bool num = false);

@@ -131,7 +131,7 @@ $PL evaluate "$R/run/points.csv" --manifest "$R/plan/plan.json" --out "$R/eval" 
 shift=$(python3 -c "import json; print(json.load(open('$T/plan/plan.json'))['cycles'][0]['end_s'] - $t1)")
 awk -F, -v OFS=, -v s="$shift" '/^#/ || /^time_s/ {print; next} {$1 = $1 + s; print}' "$R/eval/errors.csv" > "$R/errors_on_piece_clock.csv"
 $PL report ttp --evaluation "$T/cmm/evaluation.json" --second "$T/om/evaluation.json" --r-test "$R/errors_on_piece_clock.csv" \
-  --html "$T/report.html" | sed 's/^/   /'
+  --inputs "$T/run/inputs.csv" --html "$T/report.html" | sed 's/^/   /'
 echo "-- the model: what the table-side model misses on the piece (seed 004 L2226) --"
 { echo "data: {inputs: run/inputs.csv, errors: cmm/errors.csv}"; cat <<'Y'
 kind: error_model
@@ -166,7 +166,9 @@ $PL simulate "$S/plan-compensated/roughing.ngc" "$S/plan-compensated/finishing.n
   --cmm-points "$S/plan-compensated/cmm_points.csv" --schedule "$S/plan-compensated/plan.json" --seed 2 --out "$S/run-compensated" > /dev/null
 $PL evaluate "$S/run-compensated/cmm_export.csv" --probe-log "$S/run-compensated/sw_probe.log" \
   --manifest "$S/plan-compensated/plan.json" --compare "$S/eval/evaluation.json" --out "$S/eval-compensated" | grep -A13 'against' | sed 's/^/   /'
-$PL report stepped --evaluation "$S/eval-compensated/evaluation.json" --html "$S/report.html" | sed 's/^/   /'
+# Both parts side by side: the plain part's numbers as printed above, the compensated part's before/after with U.
+$PL report stepped --evaluation "$S/eval/evaluation.json" --compensated "$S/eval-compensated/evaluation.json" \
+  --html "$S/report.html" | sed 's/^/   /'
 echo "-- the campaign (Sec. 3.5-3.6): thermal stages W6 / W1 / W7 (1000 / 3500 / 5500 rpm), W8's process error without them,"
 echo "   the control errors of W2 (transitions at 1200 mm/min) and W5 (one continuous path) against W8"
 sw_part() {  # DIR EXPERIMENT SEED: plan, cut on the virtual VMC (its waits), CMM + probe log, evaluate

@@ -28,7 +28,7 @@ and the compensated part's components again agree with the truth (the offsets ac
 Needs $PROBELOOP and $PROBELOOP_SOURCE_DIR. SW_QUICK=1 (the sanitizer build): seed 1, its
 compensated part, the report and the refusals only.
 """
-import csv, json, os, re, subprocess, sys, tempfile
+import csv, json, math, os, re, subprocess, sys, tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks  # noqa: E402
@@ -292,14 +292,90 @@ if code == 0 and not QUICK:
           len(ba_w1) == 12 and rms_w1("after_um") < 0.4 * rms_w1("before_um"), out)
 
 # --- the HTML report, rendered in Chromium -----------------------------------------------------------
-from html_render import check as render_check  # noqa: E402
-for name, ev_dir, plots in (("one part", ev1, 3), ("compensated part", ev_c, 4)):
-    code, out, err = run("report", "stepped", "--evaluation", f"{ev_dir}/evaluation.json", "--html", f"{ev_dir}/report.html")
-    ok, text = render_check(f"{ev_dir}/report.html", plots) if code == 0 else (False, err)
+from html_render import TreeBuilder, check as render_check, check_dom, render  # noqa: E402
+
+
+def gum(v, U):
+    """value +- U as the page prints it (report/vega.cpp valueU: U to two significant digits)."""
+    d = max(0, 1 - math.floor(math.log10(U)))
+    value = f"{v:.{d}f}"
+    if value.startswith("-") and not value.strip("-0."):
+        value = value[1:]  # "-0.00" -> "0.00", as the page prints it
+    return f"{value} \u00b1 {U:.{d}f}"
+
+
+def sw_page_check(path, plain_ev, n_plots):
+    """The two-part page: rendered, error bars on before and after, tables in scroll containers,
+    the plain part's components as evaluate wrote them, U on every width and depth error,
+    orientations within their U marked "not resolved"."""
+    lines, ok = [], True
+    html = open(path, encoding="utf-8").read()
+    dom, seconds, _ = render(path)
+    r_ok, r_lines = check_dom(dom, n_plots)
+    ok, lines = ok and r_ok, lines + [l for l in r_lines if l.startswith("FAIL")] + [f"rendered in {seconds:.1f} s"]
+    tree = TreeBuilder()
+    tree.feed(dom)
+    tree.close()
+    nodes = list(tree.root.walk())
+    for name in ("before_error_bars", "after_error_bars", "promised_error_bars"):
+        groups = [n for n in nodes if n.tag == "g" and name in n.classes()]
+        bars = sum(1 for g in groups for x in g.walk() if x.tag == "line")
+        ok &= bars == 12
+        lines.append(f"{'ok  ' if bars == 12 else 'FAIL'} {name}: {bars} bars drawn (12 features)")
+    # Dump-dom cannot measure layout: every table must sit directly in a scroll container.
+    tables = [n for n in nodes if n.tag == "table"]
+    wrapped = [c for n in nodes if n.tag == "div" and "table-wrap" in n.classes() for c in n.children
+               if not isinstance(c, str) and c.tag == "table"]
+    css = re.search(r"\.table-wrap \{[^}]*overflow-x: auto", html) is not None
+    ok &= len(tables) == len(wrapped) and len(tables) >= 5 and css
+    lines.append(f"{len(wrapped)} of {len(tables)} tables inside div.table-wrap (overflow-x: auto: {css})")
+    # The plain part's components, as its evaluation.json holds them (what evaluate printed).
+    comp = html[html.find('<table class="components">'):]
+    comp = comp[:comp.find("</table>")]
+    missing = []
+    for st in plain_ev["separation"]:
+        row = comp[comp.find(f"<tr><td>uncompensated</td><td>{st['step']}</td>"):]
+        row = row[:row.find("</tr>")]
+        for key in ("e_pos_x_um", "e_pos_y_um", "e_proc_x_um", "e_proc_y_um", "e_splz_um"):
+            if gum(st[key]["value"], st[key]["U"]) not in row:
+                missing.append(f"step {st['step']} {key} {gum(st[key]['value'], st[key]['U'])}")
+    ok &= not missing
+    lines.append(f"FAIL the plain part's components not on the page: {missing}" if missing
+                 else "ok   the plain part's components as its evaluation.json holds them")
+    geo = html[html.find('<table class="geometry">'):]
+    cells = re.findall(r'<td class="num[^"]*">([^<]*)', geo[:geo.find("</table>")])
+    with_u = sum(1 for c in cells if "\u00b1" in c)
+    ok &= cells and with_u == len(cells)
+    lines.append(f"width and depth errors with U: {with_u} of {len(cells)}")
+    ori = html[html.find('<table class="orientations">'):]
+    ori = ori[:ori.find("</table>")]
+    wrong = 0
+    for cls, v, U, mark in re.findall(r'<td class="(num[^"]*)">(-?[\d.]+) \u00b1 ([\d.]+)( <span class="ns-mark">not resolved)?', ori):
+        wrong += (abs(float(v)) <= float(U)) != ("ns" in cls.split() and bool(mark))
+    ok &= wrong == 0
+    lines.append(f"orientations: {wrong} marked wrongly (|value| <= U must be 'not resolved', and only those)")
+    return ok, "\n".join(lines)
+
+
+for name, args, out_html, plots in (("one part", ["--evaluation", f"{ev1}/evaluation.json"], f"{ev1}/report.html", 3),
+                                    ("compensated part alone (the old form)", ["--evaluation", f"{ev_c}/evaluation.json"],
+                                     f"{ev_c}/report.html", 4)):
+    code, out, err = run("report", "stepped", *args, "--html", out_html)
+    ok, text = render_check(out_html, plots) if code == 0 else (False, err)
     check(f"report stepped ({name}): {plots} plots render in Chromium with no error", ok, text)
-page = open(f"{ev_c}/report.html").read() if os.path.exists(f"{ev_c}/report.html") else ""
+both = f"{W}/report-both.html"
+code, out, err = run("report", "stepped", "--evaluation", f"{ev1}/evaluation.json", "--compensated", f"{ev_c}/evaluation.json",
+                     "--html", both)
+ok, text = sw_page_check(both, json.load(open(f"{ev1}/evaluation.json")), 4) if code == 0 else (False, err)
+check("report stepped, both parts side by side: 4 plots render, before/after each with U bars, every table in a "
+      "scroll container, the plain part's numbers as evaluated, U on widths and depths, unresolved tilts marked", ok, text)
+page = open(both).read() if os.path.exists(both) else ""
 check("the report's before/after table lists the 12 widths and depths",
       all(f"S{k} {q}" in page for k in range(1, 5) for q in ("width_x", "width_y", "depth")), page[:300])
+code, out, err = run("report", "stepped", "--evaluation", f"{ev_c}/evaluation.json",
+                     "--compensated", f"{ev1}/evaluation.json", "--html", f"{W}/bad-pair.html")
+check("report stepped refuses a compensated part that was not compared with --evaluation",
+      code != 0 and not os.path.exists(f"{W}/bad-pair.html"), err)
 code, out, err = run("report", "stepped", "--evaluation", f"{plan_dir}/plan.json", "--html", f"{W}/bad.html")
 check("report stepped refuses what is not a stepped-workpiece evaluation", code != 0 and "plan.json" in err
       and not os.path.exists(f"{W}/bad.html"), err)

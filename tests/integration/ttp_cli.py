@@ -284,12 +284,15 @@ if cmd:
 
 # --- the HTML report in headless Chromium, the glTF scene validated -------------------------
 code, out, err = run("report", "ttp", "--evaluation", f"{W}/cmm/evaluation.json", "--second", f"{W}/om/evaluation.json",
-                     "--html", f"{W}/report.html", "--scene", f"{W}/scene.gltf", "--manifest", f"{fa}/plan.json")
+                     "--inputs", f"{W}/run/inputs.csv", "--html", f"{W}/report.html", "--scene", f"{W}/scene.gltf",
+                     "--manifest", f"{fa}/plan.json")
 check("probeloop report ttp writes the page and the scene", code == 0, err)
 if code == 0:
     from ttp_report_check import check as report_check  # noqa: E402
-    ok, text = report_check(f"{W}/report.html", quantities=["EX_um", "EY_um", "EZ_um", "EB_urad", "ETTP_um", "dT_K"])
-    check("the report renders every plot in headless Chromium", ok, text)
+    ok, text = report_check(f"{W}/report.html", quantities=["EX_um", "EY_um", "EZ_um", "EB_urad", "ETTP_um", "dT_K"],
+                            n_plots=8, inputs=f"{W}/run/inputs.csv")
+    check("the report renders every plot in headless Chromium, the temperatures and C load from inputs.csv drawn, "
+          "no notes paths or line numbers, the misprinted Eqs. 7.1/7.2 only in the appendix", ok, text)
     if os.path.isdir(f"{SRC}/tests/tools/node_modules/gltf-validator"):
         p = subprocess.run(["node", f"{SRC}/tests/tools/validate_gltf.mjs", f"{W}/scene.gltf"], capture_output=True, text=True)
         check("the test piece's scene passes the Khronos validator", p.returncode == 0, p.stdout + p.stderr)
