@@ -193,7 +193,8 @@ json pointMark(const char* name, const char* data, const char* y_field, const js
   return {{"type", "symbol"}, {"name", name}, {"from", {{"data", data}}}, {"encode", {{"enter", points}}}};
 }
 
-// Each measured value with its U (k = 2) as a vertical bar from value − U to value + U.
+// Each measured value with its U (k = 2) as a vertical bar from value − U to value + U (none
+// where U is 0: the reference cycle, exact by definition).
 json errorBarMark(const char* data, std::size_t n) {
   return {{"type", "rule"},
           {"name", "error_bar_rules"},
@@ -231,7 +232,7 @@ json fitPlotSpec(const ChannelName& n, const SeriesData& d, const std::optional<
                                                      formulaTx("lo", "datum.predicted - datum.U"),
                                                      formulaTx("hi", "datum.predicted + datum.U")})}});
   spec["data"].push_back({{"name", "error_bars"}, {"source", "series"},
-                          {"transform", json::array({filterTx("isValid(datum.measured) && isValid(datum.U)"),
+                          {"transform", json::array({filterTx("isValid(datum.measured) && isValid(datum.U) && datum.U > 0"),
                                                      formulaTx("U_lo", "datum.measured - datum.U"),
                                                      formulaTx("U_hi", "datum.measured + datum.U")})}});
   if (d.has_before)
