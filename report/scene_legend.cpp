@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <vector>
@@ -118,7 +121,84 @@ std::string objectsTable(const json& g) {
   return t + "</tbody>\n</table>\n";
 }
 
+// ---- The embedded view: three.js r111 from Debian's libjs-three, inlined like Vega.
+struct ThreeFile {
+  const char* path;  // under the libjs-three directory
+  const char* what;
+};
+constexpr ThreeFile kThreeFiles[] = {
+    {"three.min.js", "three.js"},
+    {"examples/js/loaders/GLTFLoader.js", "GLTFLoader"},
+    {"examples/js/controls/OrbitControls.js", "OrbitControls"},
+};
+
+// Script text that cannot end its <script> element ("</script", "<!--" only occur in string
+// literals of these files, where \x3C means the same "<").
+std::string scriptSafe(std::string js) {
+  std::string lower = js;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+  for (const std::string from : {"</script", "<!--"})
+    for (std::size_t pos = lower.find(from); pos != std::string::npos; pos = lower.find(from, pos + 1)) {
+      js.replace(pos, 1, "\\x3C");
+      lower.replace(pos, 1, "\\x3C");
+    }
+  return js;
+}
+
+// The three scripts, or nullopt when one is missing (the page then says how to get them).
+std::optional<std::string> threeRuntime(const std::string& dir) {
+  std::string js;
+  for (const auto& f : kThreeFiles) {
+    std::ifstream in(std::filesystem::path(dir) / f.path, std::ios::binary);
+    if (!in) return std::nullopt;
+    std::ostringstream s;
+    s << in.rdbuf();
+    js += "<script>/* " + std::string(f.what) + " (Debian libjs-three) */\n" + scriptSafe(s.str()) + "\n</script>\n";
+  }
+  return js;
+}
+
+// Loads the scene from its <script type="application/json">, frames it, renders on demand;
+// marks #viewer data-rendered="true" and data-drawn-pixels (pixels not background) so a test
+// can tell a drawn view from a blank canvas; errors land in #viewer-errors.
+constexpr const char* kViewerScript = R"JS(
+(function () {
+  var div = document.getElementById('viewer'), errors = document.getElementById('viewer-errors');
+  function fail(e) { var p = document.createElement('p'); p.textContent = 'viewer: ' + (e && e.message ? e.message : String(e)); errors.appendChild(p); }
+  try {
+    var W = 900, H = 560;
+    var renderer = new THREE.WebGLRenderer({antialias: true, preserveDrawingBuffer: true});
+    renderer.setSize(W, H);
+    div.appendChild(renderer.domElement);
+    var scene = new THREE.Scene();
+    scene.background = new THREE.Color(0xffffff);
+    scene.add(new THREE.HemisphereLight(0xffffff, 0x555555, 1.0));
+    var camera = new THREE.PerspectiveCamera(40, W / H, 0.001, 1000);
+    var controls = new THREE.OrbitControls(camera, renderer.domElement);
+    var draw = function () { renderer.render(scene, camera); };
+    new THREE.GLTFLoader().parse(document.getElementById('scene-gltf').textContent, '', function (gltf) {
+      scene.add(gltf.scene);
+      var box = new THREE.Box3().setFromObject(gltf.scene);
+      var c = box.getCenter(new THREE.Vector3()), size = box.getSize(new THREE.Vector3()).length();
+      camera.position.set(c.x + 0.6 * size, c.y + 0.6 * size, c.z + 0.9 * size);
+      camera.lookAt(c);
+      controls.target.copy(c);
+      controls.update();
+      controls.addEventListener('change', draw);
+      draw();
+      var gl = renderer.getContext(), px = new Uint8Array(4 * W * H), n = 0;
+      gl.readPixels(0, 0, W, H, gl.RGBA, gl.UNSIGNED_BYTE, px);
+      for (var i = 0; i < px.length; i += 4) if (px[i] < 250 || px[i + 1] < 250 || px[i + 2] < 250) n++;
+      div.setAttribute('data-drawn-pixels', String(n));
+      div.setAttribute('data-rendered', 'true');
+    }, fail);
+  } catch (e) { fail(e); }
+})();
+)JS";
+
 }  // namespace
+
+std::string defaultThreePath() { return "/usr/share/javascript/three"; }
 
 std::string sceneLegendPath(const std::string& scene_path) {
   std::filesystem::path p(scene_path);
@@ -126,7 +206,7 @@ std::string sceneLegendPath(const std::string& scene_path) {
   return scene_path + ".html";
 }
 
-std::string sceneLegendHtml(const std::string& gltf_text, const std::string& scene_file_name) {
+std::string sceneLegendHtml(const std::string& gltf_text, const std::string& scene_file_name, const std::string& three_js_dir) {
   const json g = json::parse(gltf_text, nullptr, false);
   if (!g.is_object() || !field(g, "asset"))
     throw InputError(scene_file_name, 0, "scene legend: not a glTF 2.0 JSON scene (no \"asset\")");
@@ -139,12 +219,25 @@ std::string sceneLegendHtml(const std::string& gltf_text, const std::string& sce
   std::string h = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<meta name=\"generator\" "
                   "content=\"probeloop\">\n<title>" +
                   esc("Scene " + scene_file_name + ": colours, exaggeration, objects") + "</title>\n<style>" + kStyle +
-                  "</style>\n</head>\n<body>\n<header>\n<h1>" + esc("Scene " + scene_file_name) + "</h1>\n" +
+                  ".viewer canvas { border: 1px solid #ddd; }\n</style>\n</head>\n<body>\n<header>\n<h1>" + esc("Scene " + scene_file_name) + "</h1>\n" +
                   "<p>The glTF 2.0 scene <a href=\"" + esc(scene_file_name) + "\">" + esc(scene_file_name) +
                   "</a>: what its colours mean in \u00b5m, how much its vectors are exaggerated, and what each object "
                   "is. Every number here is read from the scene file itself.</p>\n</header>\n";
 
-  h += "<section class=\"scale\">\n<h2>Colour scale</h2>\n";
+  // The view first: what the numbers below describe.
+  h += "<section class=\"view\">\n<h2>The scene</h2>\n";
+  const std::optional<std::string> three = threeRuntime(three_js_dir);
+  if (three) {
+    h += "<div id=\"viewer\" class=\"viewer\"></div>\n<div id=\"viewer-errors\" class=\"errors\" role=\"alert\"></div>\n"
+         "<p class=\"note\">Drag to turn, scroll to zoom, right-drag to pan (three.js " +
+         std::string("r111, from Debian's libjs-three, inlined: the page opens offline).</p>\n") +
+         "<script type=\"application/json\" id=\"scene-gltf\">" + scriptJson(g) + "</script>\n" + *three +
+         "<script>" + kViewerScript + "</script>\n";
+  } else {
+    h += "<p id=\"no-viewer\" class=\"note\">No embedded view: it needs three.js from Debian's libjs-three (" +
+         esc(three_js_dir) + "; apt-get install libjs-three, scripts/setup.sh installs it). Open the scene as below.</p>\n";
+  }
+  h += "</section>\n<section class=\"scale\">\n<h2>Colour scale</h2>\n";
   if (limit && *limit > 0) {
     h += colourScaleSvg(*limit, srgbHex(array(scale, "negative")), srgbHex(array(scale, "zero")),
                         srgbHex(array(scale, "positive")));

@@ -9,7 +9,13 @@
 //   exaggeration, reference_cycle, colour_scale {limit_um, negative, zero, positive,
 //   meaning}; the node names), never passed beside it, so page and scene cannot disagree.
 //   Text that is not a glTF JSON object is InputError.
-// - Output: one HTML5 page (UTF-8) that needs no script and no network:
+// - Output: one HTML5 page (UTF-8) that needs no network:
+//   * an interactive view of the scene (<div id="viewer">, WebGL) when three_js_dir holds
+//     Debian's libjs-three (three.min.js, examples/js/loaders/GLTFLoader.js,
+//     examples/js/controls/OrbitControls.js): the three files and the scene (its JSON, with
+//     <, > and & escaped) are inlined; the view marks #viewer data-rendered="true" and
+//     data-drawn-pixels, and writes errors into #viewer-errors. Without them: a note
+//     <p id="no-viewer"> naming the package, and nothing else changes;
 //   * with a colour scale: an inline SVG gradient <svg id="colour-scale"> from −L through 0
 //     to +L, the scene's own colours converted from glTF's linear RGB to sRGB so the page
 //     shows what a viewer shows, with five numbered ticks −L, −L/2, 0, +L/2, +L in µm
@@ -26,7 +32,11 @@
 
 namespace probeloop::report {
 
-std::string sceneLegendHtml(const std::string& gltf_text, const std::string& scene_file_name);
+// Where Debian's libjs-three installs three.js: /usr/share/javascript/three.
+std::string defaultThreePath();
+
+std::string sceneLegendHtml(const std::string& gltf_text, const std::string& scene_file_name,
+                            const std::string& three_js_dir = defaultThreePath());
 
 // The page's path for a scene's path: FILE.gltf -> FILE.html (any other extension: + ".html").
 std::string sceneLegendPath(const std::string& scene_path);

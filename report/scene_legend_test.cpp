@@ -1,7 +1,10 @@
 #include "report/scene_legend.hpp"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <filesystem>
+#include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -59,6 +62,8 @@ json evaluationFor(const parts::PlanManifest& m, double facet_um_per_cycle, doub
           {"features", features}, {"cycles", cycles}};
 }
 
+const std::string kNoThree = "/nonexistent/three";
+
 std::string ticks(const std::string& html) {
   std::string out;
   for (std::size_t p = html.find("<text class=\"tick\""); p != std::string::npos; p = html.find("<text class=\"tick\"", p + 1)) {
@@ -73,11 +78,11 @@ TEST(SceneLegend, TicksComeFromTheScenesColourScale) {
   // Z paths 3 µm deeper per cycle: the largest |change| is 24 µm at cycle 8, so the scene's
   // limit is the next 1-2-5 step, 50 µm, and the ticks are ±50, ±25 and 0.
   const std::string scene = thermalTestPieceSceneGltf(m, evaluationFor(m, 1.0, 3.0), 1000);
-  const std::string html = sceneLegendHtml(scene, "scene.gltf");
+  const std::string html = sceneLegendHtml(scene, "scene.gltf", kNoThree);
   EXPECT_EQ(ticks(html), "-50 \u00b5m | -25 \u00b5m | 0 | +25 \u00b5m | +50 \u00b5m");
   EXPECT_NE(html.find("<svg id=\"colour-scale\""), std::string::npos);
   // 1 µm per cycle on the Z paths: 8 µm at most, limit 10 µm.
-  const std::string small = sceneLegendHtml(thermalTestPieceSceneGltf(m, evaluationFor(m, 0.5, 1.0), 250), "s.gltf");
+  const std::string small = sceneLegendHtml(thermalTestPieceSceneGltf(m, evaluationFor(m, 0.5, 1.0), 250), "s.gltf", kNoThree);
   EXPECT_EQ(ticks(small), "-10 \u00b5m | -5 \u00b5m | 0 | +5 \u00b5m | +10 \u00b5m");
   // The exaggeration as the scene holds it: x250 draws 1 µm as 0.25 mm.
   EXPECT_NE(small.find("\u00d7250: a displacement of 1 \u00b5m draws 0.25 mm"), std::string::npos);
@@ -86,7 +91,7 @@ TEST(SceneLegend, TicksComeFromTheScenesColourScale) {
 
 TEST(SceneLegend, GradientShowsTheScenesColoursInSrgb) {
   const auto m = ttpManifest();
-  const std::string html = sceneLegendHtml(thermalTestPieceSceneGltf(m, evaluationFor(m, 1.0, 3.0), 1000), "scene.gltf");
+  const std::string html = sceneLegendHtml(thermalTestPieceSceneGltf(m, evaluationFor(m, 1.0, 3.0), 1000), "scene.gltf", kNoThree);
   // Linear 0.90 grey is sRGB 0.9547 = 243 (IEC 61966-2-1); linear 0.13, 0.30, 0.75 = 101, 149, 225.
   EXPECT_NE(html.find("stop-color=\"#f3f3f3\""), std::string::npos);
   EXPECT_NE(html.find("stop-color=\"#6595e1\""), std::string::npos);
@@ -94,13 +99,15 @@ TEST(SceneLegend, GradientShowsTheScenesColoursInSrgb) {
 
 TEST(SceneLegend, NamesEveryKindOfObjectWithItsCount) {
   const auto m = ttpManifest();
-  const std::string html = sceneLegendHtml(thermalTestPieceSceneGltf(m, evaluationFor(m, 1.0, 3.0), 1000), "scene.gltf");
+  const std::string html = sceneLegendHtml(thermalTestPieceSceneGltf(m, evaluationFor(m, 1.0, 3.0), 1000), "scene.gltf", kNoThree);
   EXPECT_NE(html.find("<td>facet </td>"), std::string::npos);
   EXPECT_NE(html.find("<td>Z path </td>"), std::string::npos);
   EXPECT_NE(html.find("<td>deviation </td>"), std::string::npos);
   EXPECT_NE(html.find("<td>colour scale</td><td class=\"num\">1</td>"), std::string::npos);
   EXPECT_NE(html.find("<a href=\"scene.gltf\">"), std::string::npos);
-  EXPECT_EQ(html.find("<script"), std::string::npos);  // nothing to run, nothing to fetch
+  EXPECT_EQ(html.find("<script"), std::string::npos);  // without three.js: nothing to run
+  EXPECT_NE(html.find("id=\"no-viewer\""), std::string::npos);
+  EXPECT_NE(html.find("libjs-three"), std::string::npos);
 }
 
 TEST(SceneLegend, SphereCampaignHasNoColourScaleAndSaysSo) {
@@ -113,7 +120,7 @@ TEST(SceneLegend, SphereCampaignHasNoColourScaleAndSaysSo) {
   s.nominal_centre_mm = Eigen::Vector3d(160, 0, 40);
   m.spheres.push_back(s);
   std::vector<CycleCentres> cycles{{1, {Eigen::Vector3d(160, 0, 40)}}, {2, {Eigen::Vector3d(160.002, 0, 40)}}};
-  const std::string html = sceneLegendHtml(campaignSceneGltf(m, cycles, 1, 10000), "campaign.gltf");
+  const std::string html = sceneLegendHtml(campaignSceneGltf(m, cycles, 1, 10000), "campaign.gltf", kNoThree);
   EXPECT_NE(html.find("id=\"no-colour-scale\""), std::string::npos);
   EXPECT_EQ(html.find("<svg"), std::string::npos);
   EXPECT_NE(html.find("\u00d710000: a displacement of 1 \u00b5m draws 10 mm"), std::string::npos);
@@ -125,14 +132,40 @@ TEST(SceneLegend, SphereCampaignHasNoColourScaleAndSaysSo) {
 TEST(SceneLegend, EscapesTheFileNameIsDeterministicAndRefusesWhatIsNotAScene) {
   const auto m = ttpManifest();
   const std::string scene = thermalTestPieceSceneGltf(m, evaluationFor(m, 1.0, 3.0), 1000);
-  const std::string html = sceneLegendHtml(scene, "a<b>&\".gltf");
+  const std::string html = sceneLegendHtml(scene, "a<b>&\".gltf", kNoThree);
   EXPECT_EQ(html.find("a<b>"), std::string::npos);
   EXPECT_NE(html.find("a&lt;b&gt;&amp;&quot;.gltf"), std::string::npos);
-  EXPECT_EQ(sceneLegendHtml(scene, "x.gltf"), sceneLegendHtml(scene, "x.gltf"));
-  EXPECT_THROW(sceneLegendHtml("not json", "x.gltf"), InputError);
-  EXPECT_THROW(sceneLegendHtml("[1, 2]", "x.gltf"), InputError);
+  EXPECT_EQ(sceneLegendHtml(scene, "x.gltf", kNoThree), sceneLegendHtml(scene, "x.gltf", kNoThree));
+  EXPECT_THROW(sceneLegendHtml("not json", "x.gltf", kNoThree), InputError);
+  EXPECT_THROW(sceneLegendHtml("[1, 2]", "x.gltf", kNoThree), InputError);
   EXPECT_EQ(sceneLegendPath("out/scene.gltf"), "out/scene.html");
   EXPECT_EQ(sceneLegendPath("out/scene.glb"), "out/scene.glb.html");
+}
+
+TEST(SceneLegend, InlinesThreeJsAndTheSceneForAnOfflineView) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("probeloop-three-" + std::to_string(::getpid()));
+  fs::create_directories(dir / "examples/js/loaders");
+  fs::create_directories(dir / "examples/js/controls");
+  std::ofstream(dir / "three.min.js") << "var THREE = {}; /* stand-in */ var s = '</script>';";
+  std::ofstream(dir / "examples/js/loaders/GLTFLoader.js") << "THREE.GLTFLoader = function () {};";
+  std::ofstream(dir / "examples/js/controls/OrbitControls.js") << "THREE.OrbitControls = function () {};";
+  const auto m = ttpManifest();
+  const std::string scene = thermalTestPieceSceneGltf(m, evaluationFor(m, 1.0, 3.0), 1000);
+  const std::string html = sceneLegendHtml(scene, "scene.gltf", dir.string());
+  fs::remove_all(dir);
+  EXPECT_NE(html.find("<div id=\"viewer\""), std::string::npos);
+  EXPECT_NE(html.find("THREE.GLTFLoader = function"), std::string::npos);
+  EXPECT_NE(html.find("THREE.OrbitControls = function"), std::string::npos);
+  EXPECT_EQ(html.find("'</script>'"), std::string::npos);  // a literal cannot end the element
+  // The scene itself, parsed back from the page, is the scene given.
+  const std::string open = "<script type=\"application/json\" id=\"scene-gltf\">";
+  const std::size_t a = html.find(open), b = html.find("</script>", a);
+  ASSERT_NE(a, std::string::npos);
+  EXPECT_EQ(json::parse(html.substr(a + open.size(), b - a - open.size())), json::parse(scene));
+  EXPECT_EQ(html.find("<script src"), std::string::npos);
+  // Without the files: the note, and the rest of the page unchanged.
+  EXPECT_NE(sceneLegendHtml(scene, "scene.gltf", kNoThree).find("id=\"no-viewer\""), std::string::npos);
 }
 
 }  // namespace

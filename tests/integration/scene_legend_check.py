@@ -5,7 +5,10 @@ writes FILE.html; report/scene_legend.hpp) in headless Chromium and checks it ag
 Usage: scene_legend_check.py FILE.gltf    (the page is FILE.html; exit 0 when every check passes)
 
 Checks, the numbers taken from the scene file itself (its extras), not from the page's code:
-  - the page loads in Chromium with no script (it needs none) and its DOM holds the scene's name;
+  - the page loads in Chromium and its DOM holds the scene's name; with the embedded view
+    (three.js from Debian's libjs-three), #viewer is marked data-rendered="true" with more than
+    1000 drawn (non-background) pixels and #viewer-errors is empty; without it, the page says
+    why (#no-viewer) and holds no script;
   - with a colour scale in the scene: <svg id="colour-scale"> holds five tick labels reading
     -L, -L/2, 0, +L/2, +L µm with L = colour_scale.limit_um, in that order, each inside the svg;
     the gradient's stops are the scene's three colours (linear RGB -> sRGB);
@@ -54,7 +57,18 @@ def check(gltf_path):
     tree.close()
     nodes = list(tree.root.walk())
     text = tree.root.text()
-    say("the page holds no script", not any(n.tag == "script" for n in nodes))
+    viewer = next((n for n in nodes if n.attrs.get("id") == "viewer"), None)
+    if viewer is not None:
+        # The embedded view (three.js from libjs-three): drawn, not a blank canvas, no error.
+        errors = next((n for n in nodes if n.attrs.get("id") == "viewer-errors"), None)
+        drawn = int(viewer.attrs.get("data-drawn-pixels", "0") or 0)
+        say("the embedded view rendered the scene (WebGL, offline)",
+            viewer.attrs.get("data-rendered") == "true" and drawn > 1000 and errors is not None and not errors.text().strip(),
+            (viewer.attrs, errors.text() if errors is not None else "no #viewer-errors"))
+        say("no script loads anything from outside", not any(n.tag == "script" and n.attrs.get("src") for n in nodes))
+    else:
+        say("no embedded view: the page says why and holds no script",
+            any(n.attrs.get("id") == "no-viewer" for n in nodes) and not any(n.tag == "script" for n in nodes))
     say("it names the scene", os.path.basename(gltf_path) in text)
     scale = extras.get("colour_scale")
     svg = next((n for n in nodes if n.tag == "svg" and n.attrs.get("id") == "colour-scale"), None)
