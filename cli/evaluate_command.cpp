@@ -2,6 +2,7 @@
 // a CMM export (CSV, QIF 3.0 Results, DMIS output) or dial-gauge readings, by the manifest's
 // kind (evaluate/piece_evaluation.hpp); optionally its glTF scene (report/evaluation_scene.hpp).
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <optional>
 
@@ -13,6 +14,7 @@
 #include "evaluate/piece_evaluation.hpp"
 #include "parts/plan_manifest.hpp"
 #include "report/evaluation_scene.hpp"
+#include "report/scene_legend.hpp"
 
 namespace probeloop::cli {
 namespace {
@@ -38,6 +40,9 @@ int runEvaluate(const EvaluateArgs& a) {
   const auto f = evaluate::evaluateTestPiece(m, req);
   const double exaggeration = a.exaggeration.value_or(report::defaultSceneExaggeration(f));
   const std::string scene = a.scene.empty() ? "" : report::evaluationSceneGltf(m, f, a.points, exaggeration);
+  // Beside the scene, the page that numbers its colours (report/scene_legend.hpp).
+  const std::string legend =
+      scene.empty() ? "" : report::sceneLegendHtml(scene, std::filesystem::path(a.scene).filename().string());
   writeFileAtomic(pathIn(a.out, evaluate::EvaluationFiles::kErrorsCsv), f.errors_csv);
   writeFileAtomic(pathIn(a.out, evaluate::EvaluationFiles::kEvaluationJson), f.evaluation_json);
   writeFileAtomic(pathIn(a.out, evaluate::EvaluationFiles::kReportMd), f.report_md);
@@ -48,6 +53,9 @@ int runEvaluate(const EvaluateArgs& a) {
     writeFileAtomic(a.scene, scene);
     std::printf("Wrote %s (%s x%s)\n", a.scene.c_str(), f.sphere ? "error vectors" : "deviation vectors",
                 formatNumber(exaggeration).c_str());
+    writeFileAtomic(report::sceneLegendPath(a.scene), legend);
+    std::printf("Wrote %s (the scene's colour scale in um, its exaggeration and objects)\n",
+                report::sceneLegendPath(a.scene).c_str());
   }
   return 0;
 }

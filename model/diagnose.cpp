@@ -9,6 +9,7 @@
 #include "core/csv.hpp"
 #include "core/error.hpp"
 #include "model/outputs.hpp"
+#include "model/verdict_strength.hpp"
 
 namespace probeloop::model {
 namespace {
@@ -197,10 +198,11 @@ Diagnosis diagnose(const Campaign& c, const ErrorModel& m, const DiagnoseOptions
     cd.u_measurement = base.u_measurement;
     cd.rms_training = rms(res, 0, n);
     cd.rms_validation = rms(res, n, N);
+    cd.has_validation = n < N;
     cd.ljung_box_lags = std::max(1, std::min(20, n / 4));
     ljungBox({res.begin(), res.begin() + n}, cd.ljung_box_lags, cd.ljung_box_Q, cd.ljung_box_p);
     cd.white = cd.ljung_box_p >= 0.01;
-    cd.within = cd.rms_validation <= 1.5 * cd.u_measurement || (n == N && cd.rms_training <= 1.5 * cd.u_measurement);
+    cd.within = cd.rms_judged() <= 1.5 * cd.u_measurement;
     // Windows where |residual| exceeds the sample's U.
     for (int k = 0; k < N;) {
       const double U = c.errors.U[ch][k];
@@ -333,21 +335,31 @@ Diagnosis diagnose(const Campaign& c, const ErrorModel& m, const DiagnoseOptions
     if (!cd.white || !cd.within) {
       all_fine = false;
       if (worst.empty())
-        worst = cd.channel + " (residual RMS " + fmt(cd.rms_validation, 2) + " " + cd.unit + " against u = " +
-                fmt(cd.u_measurement, 2) + ", Ljung-Box p = " + formatNumber(cd.ljung_box_p, 3) + ")";
+        worst = cd.channel + " (residual RMS " + fmt(cd.rms_judged(), 2) + " " + cd.unit + " against u = " +
+                fmt(cd.u_measurement, 2) + ", Ljung-Box " + pValueClause(cd.ljung_box_p) + ")";
     }
+  // "Within 1.5 u" says little where u dwarfs the residual: name those channels.
+  std::string weak;
+  for (const auto& cd : d.channels)
+    if (cd.within && uOverResidual(cd.u_measurement, cd.rms_judged()) >= kWeakVerdictRatio)
+      weak += (weak.empty() ? "" : ", ") + cd.channel + " (u = " + ratioText(uOverResidual(cd.u_measurement, cd.rms_judged())) +
+              "\u00d7 the residual)";
+  const std::string weak_note =
+      weak.empty() ? "" : " The verdict is weak on " + weak + ": the model cannot be judged finer than u there.";
   if (!d.ranked.empty()) {
     d.verdict = "missing";
     d.message = d.ranked.front().sentence + " Add it with: " + d.ranked.front().command;
   } else if (all_fine) {
     d.verdict = "nothing_missing";
     d.message = "Nothing is missing: every residual is white (Ljung-Box p >= 0.01) and within 1.5 u of the measurement, "
-                "and none of the " + std::to_string(d.candidates_tried) + " candidates lowers the validation error beyond chance.";
+                "and none of the " + std::to_string(d.candidates_tried) + " candidates lowers the validation error beyond chance." +
+                weak_note;
   } else if (std::all_of(d.channels.begin(), d.channels.end(), [](const ChannelDiagnosis& x) { return x.within; })) {
     d.verdict = "unexplained";
     d.message = "Every residual is within 1.5 u of the measurement, but " + worst +
                 " is not white: a small systematic effect remains that none of the " + std::to_string(d.candidates_tried) +
-                " candidates explains beyond chance. Nothing in the library is worth adding; log more inputs if it matters.";
+                " candidates explains beyond chance. Nothing in the library is worth adding; log more inputs if it matters." +
+                weak_note;
   } else {
     d.verdict = "unexplained";
     d.message = "The model fails on " + worst + ", but none of the " + std::to_string(d.candidates_tried) +

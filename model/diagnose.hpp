@@ -44,7 +44,10 @@ struct CrossCorrelation {
 struct ChannelDiagnosis {
   std::string channel, unit;
   double u_measurement = 0;
-  double rms_training = 0, rms_validation = 0;
+  double rms_training = 0, rms_validation = 0;  // rms_validation: 0 without a validation span
+  bool has_validation = false;
+  // The RMS the verdict "within 1.5 u" judges: the validation span's, else the training span's.
+  double rms_judged() const { return has_validation ? rms_validation : rms_training; }
   double ljung_box_Q = 0, ljung_box_p = 1;
   int ljung_box_lags = 0;
   bool white = true, within = true;

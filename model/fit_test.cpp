@@ -9,6 +9,7 @@
 
 #include "core/error.hpp"
 #include "model/diagnose.hpp"
+#include "model/outputs.hpp"
 #include "model/fit.hpp"
 
 using namespace probeloop;
@@ -223,4 +224,40 @@ TEST(FitChannel, AFixedTimeConstantIsUsedAsGivenAndIsNoParameter) {
   const auto g = fitChannel(s.c, "EY0C_um", {lag}, n);
   EXPECT_NEAR(g.effects[1].parameters[0].value, 0.012, 4 * g.effects[1].parameters[0].u);
   EXPECT_LT(g.effects[1].parameters[0].u, 2e-4);
+}
+
+// "Within 1.5 u" is weak where u dwarfs the residual (model/verdict_strength.hpp): the
+// diagnosis and the fit say so, with the ratio, in the message and in the text.
+TEST(Diagnose, SaysHowWeakWithinIsWhenUDwarfsTheResidual) {
+  auto s = makeCampaign(0.012, 2400, 0.3, 13);
+  ErrorModel m;
+  m.file = "m.yaml";
+  m.channels = {{"EY0C_um", {makeEffect(EffectKind::Lag, "c_rpm")}}, {"EX0C_um", {}}};
+  // As generated, u = U/2 = 0.3 um, the noise itself: a fair verdict, no note.
+  auto d = diagnose(s.c, m, {});
+  ASSERT_EQ(d.verdict, "nothing_missing") << d.message;
+  EXPECT_EQ(d.message.find("weak"), std::string::npos) << d.message;
+  EXPECT_EQ(diagnosisText(s.c, m, d).find("cannot be judged finer than u"), std::string::npos);
+  // The same residual against a claimed U three times larger: u = 0.9 um, about 3x the residual.
+  for (auto& U : s.c.errors.U)
+    for (double& v : U) v *= 3;
+  d = diagnose(s.c, m, {});
+  ASSERT_EQ(d.verdict, "nothing_missing") << d.message;
+  EXPECT_NE(d.message.find("The verdict is weak on EY0C_um"), std::string::npos) << d.message;
+  const std::string text = diagnosisText(s.c, m, d);
+  EXPECT_NE(text.find("note: the measurement's uncertainty (u = 0.9 um) is "), std::string::npos) << text;
+  EXPECT_NE(text.find("\u00d7 the residual (RMS 0."), std::string::npos) << text;
+  EXPECT_NE(fitText(s.c, m, fitModel(s.c, m)).find("note: the measurement's uncertainty (u = 0.9 um)"), std::string::npos);
+}
+
+TEST(Diagnose, PrintsAVanishingPValueAsABoundNeverZero) {
+  const auto s = makeCampaign(0.012, 2400, 0.3, 11);
+  ErrorModel m;
+  m.file = "m.yaml";
+  m.channels = {{"EY0C_um", {}}, {"EX0C_um", {}}};
+  const auto d = diagnose(s.c, m, {});
+  ASSERT_LT(d.channels[0].ljung_box_p, 1e-4);  // the hidden rotary heat: a structured residual
+  const std::string text = diagnosisText(s.c, m, d);
+  EXPECT_NE(text.find("NOT white, p < 1e-4"), std::string::npos) << text;
+  EXPECT_EQ(text.find("p = 0 "), std::string::npos) << text;
 }

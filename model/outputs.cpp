@@ -6,6 +6,7 @@
 
 #include "core/csv.hpp"
 #include "core/error.hpp"
+#include "model/verdict_strength.hpp"
 
 namespace probeloop::model {
 namespace {
@@ -98,8 +99,14 @@ std::string fitText(const Campaign& c, const ErrorModel& m, const ModelFit& f) {
   o << "\n";
   for (std::size_t i = 0; i < f.after.size(); ++i) {
     const ChannelFit& a = f.after[i];
+    // The residual a reader compares with u: the validation span's RMSE, else the training span's.
+    const double judged = a.has_validation ? a.validation.rmse : a.training.rmse;
     o << "\n" << a.channel << "  (measurement u = " << g(a.u_measurement) << " " << a.unit << "; residual sigma " << g(a.sigma) << " " << a.unit
-      << ")\n  effects: " << effectList(a.effects) << "\n";
+      << "; u / " << (a.has_validation ? "validation" : "training") << " RMSE = " << ratioText(uOverResidual(a.u_measurement, judged))
+      << ")\n";
+    if (const std::string weak = weakVerdictSentence(a.u_measurement, judged, a.unit); !weak.empty())
+      o << "  note: " << weak << "\n";
+    o << "  effects: " << effectList(a.effects) << "\n";
     for (const auto& fe : a.effects)
       for (const auto& p : fe.parameters) {
         char b[256];
@@ -200,7 +207,7 @@ std::string diagnosisText(const Campaign& c, const ErrorModel& m, const Diagnosi
   std::ostringstream o;
   o << "Diagnosis of " << m.file << " on " << c.errors.size() << " cycles (" << d.candidates_tried << " candidate fits)\n\n";
   char h[256];
-  std::snprintf(h, sizeof h, "  %-11s %-22s %-22s %-22s %s\n", "channel", "RMS train / valid", "vs u of measurement", "whiteness (Ljung-Box)",
+  std::snprintf(h, sizeof h, "  %-11s %-22s %-37s %-24s %s\n", "channel", "RMS train / valid", "vs u of measurement", "whiteness (Ljung-Box)",
                 "largest cross-correlation");
   o << h;
   for (const auto& cd : d.channels) {
@@ -209,11 +216,14 @@ std::string diagnosisText(const Campaign& c, const ErrorModel& m, const Diagnosi
       cc = cd.cross.front().input + " r = " + g(cd.cross.front().r, 2) + " at lag " + g(cd.cross.front().lag_s / 60, 3) + " min" +
            (cd.cross.front().significant ? "" : " (not significant)");
     char r[512];
-    std::snprintf(r, sizeof r, "  %-11s %-22s %-22s %-22s %s\n", cd.channel.c_str(),
-                  (g(cd.rms_training) + " / " + g(cd.rms_validation) + " " + cd.unit).c_str(),
-                  ((cd.within ? "within 1.5u (u = " : "beyond 1.5u (u = ") + g(cd.u_measurement) + ")").c_str(),
-                  ((cd.white ? "white, p = " : "NOT white, p = ") + g(cd.ljung_box_p, 2)).c_str(), cc.c_str());
+    std::snprintf(r, sizeof r, "  %-11s %-22s %-37s %-24s %s\n", cd.channel.c_str(),
+                  (g(cd.rms_training) + " / " + (cd.has_validation ? g(cd.rms_validation) : std::string("-")) + " " + cd.unit).c_str(),
+                  ((cd.within ? "within 1.5u (u = " : "beyond 1.5u (u = ") + g(cd.u_measurement) + ", " +
+                   "u/RMS = " + ratioText(uOverResidual(cd.u_measurement, cd.rms_judged())) + ")").c_str(),
+                  ((cd.white ? "white, " : "NOT white, ") + pValueClause(cd.ljung_box_p)).c_str(), cc.c_str());
     o << r;
+    if (const std::string weak = weakVerdictSentence(cd.u_measurement, cd.rms_judged(), cd.unit); !weak.empty())
+      o << "      note: " << weak << "\n";
     for (const auto& w : cd.windows)
       o << "      |residual| > U from " << hours(w.from_s) << " to " << hours(w.to_s) << " (" << w.samples << " cycles, peak "
         << g(w.peak) << " " << cd.unit << ")\n";
@@ -246,7 +256,8 @@ nlohmann::json diagnosisJson(const Campaign& c, const ErrorModel& m, const Diagn
   nlohmann::json chans = nlohmann::json::array();
   for (const auto& cd : d.channels) {
     nlohmann::json x{{"channel", cd.channel}, {"unit", cd.unit}, {"u_measurement", cd.u_measurement},
-                     {"rms_residual", {{"training", cd.rms_training}, {"validation", cd.rms_validation}}},
+                     {"rms_residual", {{"training", cd.rms_training},
+                                       {"validation", cd.has_validation ? nlohmann::json(cd.rms_validation) : nlohmann::json(nullptr)}}},
                      {"ljung_box", {{"Q", cd.ljung_box_Q}, {"lags", cd.ljung_box_lags}, {"p", cd.ljung_box_p}}},
                      {"white", cd.white}, {"within", cd.within}};
     nlohmann::json w = nlohmann::json::array();

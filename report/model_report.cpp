@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "model/verdict_strength.hpp"
 #include "report/vega.hpp"
 
 namespace probeloop::report {
@@ -56,16 +57,24 @@ std::string axisTitle(const ChannelName& n, const std::string& prefix) {
 // Vega specs (declarative JSON; Vega draws them). Data values are the input's numbers;
 // hours, residual and band limits are Vega formulas.
 
+// The model is drawn last, over the points, in a colour no point has (orange against
+// near-black) and wider, so hundreds of points cannot hide it.
 const char* kMeasuredColour = "#222222";
-const char* kModelColour = "#1f5f9f";
-const char* kBandColour = "#cfe0f1";
+const char* kErrorBarColour = "#555555";
+const char* kModelColour = "#e66100";
+const char* kBandColour = "#fbe0c8";
 const char* kBeforeColour = "#8a8a8a";
 const char* kBeyondColour = "#c0392b";
 
 struct SeriesData {
   json rows = json::array();
   bool has_measured = false, has_predicted = false, has_U = false, has_before = false;
+  std::size_t measured = 0;  // rows with a measured value
 };
+
+// Above this many points, smaller and translucent points (and fainter error bars) keep the
+// model line and the density of the points readable.
+constexpr std::size_t kManyPoints = 150;
 
 json finiteOrNull(const json& a, std::size_t i) {
   if (i < a.size() && number(&a[i])) return a[i];
@@ -88,6 +97,7 @@ SeriesData seriesData(const json& series) {
     row["predicted"] = finiteOrNull(p, i);
     row["U"] = U_scalar ? json(*U_scalar) : finiteOrNull(U, i);
     d.has_measured |= !row["measured"].is_null();
+    d.measured += row["measured"].is_null() ? 0 : 1;
     d.has_predicted |= !row["predicted"].is_null();
     d.has_U |= !row["U"].is_null();
     if (!b.empty()) {
@@ -133,16 +143,25 @@ void addValidationWindow(json& spec, const std::optional<Window>& validation) {
                                                   {"y2", {{"signal", "height"}}},
                                                   {"fill", {{"value", "#000000"}}},
                                                   {"fillOpacity", {{"value", 0.04}}}}}}}});
+}
+
+// The window's label, added last so no mark covers it. Centred over the window and never
+// clipped: a window at the right edge (or narrower than the word) cannot cut it, and the
+// spec's autosize "pad" grows the view to whatever the label needs.
+void addValidationLabel(json& spec, const std::optional<Window>& validation) {
+  if (!validation) return;
   spec["marks"].push_back({{"type", "text"},
+                           {"name", "validation_label"},
                            {"from", {{"data", "validation"}}},
-                           {"clip", true},
-                           {"encode", {{"enter", {{"x", {{"scale", "x"}, {"field", "from_h"}, {"offset", 4}}},
-                                                  {"y", {{"value", 4}}},
+                           {"clip", false},
+                           {"encode", {{"enter", {{"x", {{"signal", "(scale('x', datum.from_h) + scale('x', datum.to_h)) / 2"}}},
+                                                  {"y", {{"value", 3}}},
+                                                  {"align", {{"value", "center"}}},
                                                   {"baseline", {{"value", "top"}}},
                                                   {"text", {{"value", "validation"}}},
-                                                  {"fill", {{"value", "#777777"}}},
+                                                  {"fill", {{"value", "#555555"}}},
                                                   {"font", {{"value", "sans-serif"}}},
-                                                  {"fontSize", {{"value", 10}}}}}}}});
+                                                  {"fontSize", {{"value", 11}}}}}}}});
 }
 
 void xScaleAndAxes(json& spec, const std::string& y_title) {
@@ -157,16 +176,40 @@ json xy(const char* y_field) {
   return {{"x", {{"scale", "x"}, {"field", "t_h"}}}, {"y", {{"scale", "y"}, {"field", y_field}}}};
 }
 
-json linePlotMark(const char* data, const char* y_field, const char* colour, bool dashed) {
+json linePlotMark(const char* name, const char* data, const char* y_field, const char* colour, double width, bool dashed) {
   json enter = xy(y_field);
   enter["stroke"] = {{"value", colour}};
-  enter["strokeWidth"] = {{"value", 1.5}};
+  enter["strokeWidth"] = {{"value", width}};
   if (dashed) enter["strokeDash"] = {{"value", json::array({6, 4})}};
-  return {{"type", "line"}, {"from", {{"data", data}}}, {"encode", {{"enter", enter}}}};
+  return {{"type", "line"}, {"name", name}, {"from", {{"data", data}}}, {"encode", {{"enter", enter}}}};
+}
+
+json pointMark(const char* name, const char* data, const char* y_field, const json& fill, std::size_t n) {
+  json points = xy(y_field);
+  points["shape"] = {{"value", "circle"}};
+  points["size"] = {{"value", n > kManyPoints ? 7 : 14}};
+  points["fill"] = fill;
+  points["fillOpacity"] = {{"value", n > kManyPoints ? 0.45 : 0.85}};
+  return {{"type", "symbol"}, {"name", name}, {"from", {{"data", data}}}, {"encode", {{"enter", points}}}};
+}
+
+// Each measured value with its U (k = 2) as a vertical bar from value − U to value + U (none
+// where U is 0: the reference cycle, exact by definition).
+json errorBarMark(const char* data, std::size_t n) {
+  return {{"type", "rule"},
+          {"name", "error_bar_rules"},
+          {"from", {{"data", data}}},
+          {"encode", {{"enter", {{"x", {{"scale", "x"}, {"field", "t_h"}}},
+                                 {"y", {{"scale", "y"}, {"field", "U_lo"}}},
+                                 {"y2", {{"scale", "y"}, {"field", "U_hi"}}},
+                                 {"stroke", {{"value", kErrorBarColour}}},
+                                 {"strokeWidth", {{"value", 1}}},
+                                 {"strokeOpacity", {{"value", n > kManyPoints ? 0.25 : 0.6}}}}}}}};
 }
 
 json bandMark(const char* data) {
   return {{"type", "area"},
+          {"name", "band_area"},
           {"from", {{"data", data}}},
           {"encode", {{"enter", {{"x", {{"scale", "x"}, {"field", "t_h"}}},
                                  {"y", {{"scale", "y"}, {"field", "lo"}}},
@@ -188,6 +231,10 @@ json fitPlotSpec(const ChannelName& n, const SeriesData& d, const std::optional<
                           {"transform", json::array({filterTx("isValid(datum.predicted) && isValid(datum.U)"),
                                                      formulaTx("lo", "datum.predicted - datum.U"),
                                                      formulaTx("hi", "datum.predicted + datum.U")})}});
+  spec["data"].push_back({{"name", "error_bars"}, {"source", "series"},
+                          {"transform", json::array({filterTx("isValid(datum.measured) && isValid(datum.U) && datum.U > 0"),
+                                                     formulaTx("U_lo", "datum.measured - datum.U"),
+                                                     formulaTx("U_hi", "datum.measured + datum.U")})}});
   if (d.has_before)
     spec["data"].push_back({{"name", "before"}, {"source", "series"},
                             {"transform", json::array({filterTx("isValid(datum.before)")})}});
@@ -200,24 +247,25 @@ json fitPlotSpec(const ChannelName& n, const SeriesData& d, const std::optional<
   if (d.has_U) {
     y_fields.push_back({{"data", "band"}, {"field", "lo"}});
     y_fields.push_back({{"data", "band"}, {"field", "hi"}});
+    y_fields.push_back({{"data", "error_bars"}, {"field", "U_lo"}});
+    y_fields.push_back({{"data", "error_bars"}, {"field", "U_hi"}});
   }
   if (d.has_before) y_fields.push_back({{"data", "before"}, {"field", "before"}});
   xScaleAndAxes(spec, axisTitle(n, ""));
   spec["scales"].push_back({{"name", "y"}, {"type", "linear"}, {"range", "height"}, {"zero", false},
                             {"nice", true}, {"domain", {{"fields", y_fields}}}});
 
+  // Drawing order: band, before, U bars, points, then the model line on top, then the label.
+  // Mark names must differ from the data sets' (Vega gives each named mark a data set).
   spec["marks"].push_back(bandMark("band"));
-  if (d.has_before) spec["marks"].push_back(linePlotMark("before", "before", kBeforeColour, true));
-  spec["marks"].push_back(linePlotMark("model", "predicted", kModelColour, false));
-  json points = xy("measured");
-  points["shape"] = {{"value", "circle"}};
-  points["size"] = {{"value", 12}};
-  points["fill"] = {{"value", kMeasuredColour}};
-  points["fillOpacity"] = {{"value", 0.8}};
-  spec["marks"].push_back({{"type", "symbol"}, {"from", {{"data", "measured"}}}, {"encode", {{"enter", points}}}});
+  if (d.has_before) spec["marks"].push_back(linePlotMark("model_before_line", "before", "before", kBeforeColour, 1.5, true));
+  if (d.has_U) spec["marks"].push_back(errorBarMark("error_bars", d.measured));
+  spec["marks"].push_back(pointMark("measured_points", "measured", "measured", {{"value", kMeasuredColour}}, d.measured));
+  spec["marks"].push_back(linePlotMark("model_line", "model", "predicted", kModelColour, 2.5, false));
+  addValidationLabel(spec, validation);
 
   const json solid = json::array({1, 0});
-  std::vector<LegendEntry> legend{{"measured", "circle", kMeasuredColour, "transparent", solid},
+  std::vector<LegendEntry> legend{{d.has_U ? "measured ± U" : "measured", "circle", kMeasuredColour, "transparent", solid},
                                   {"model", "stroke", "transparent", kModelColour, solid}};
   if (d.has_U) legend.push_back({"model \u00b1 U", "square", kBandColour, kBandColour, solid});
   if (d.has_before) legend.push_back({"model before", "stroke", "transparent", kBeforeColour, json::array({6, 4})});
@@ -257,12 +305,10 @@ json residualPlotSpec(const ChannelName& n, const SeriesData& d, const std::opti
                                                   {"y", {{"scale", "y"}, {"value", 0}}},
                                                   {"stroke", {{"value", "#999999"}}},
                                                   {"strokeWidth", {{"value", 1}}}}}}}});
-  json points = xy("residual");
-  points["shape"] = {{"value", "circle"}};
-  points["size"] = {{"value", 12}};
-  points["fill"] = json::array({{{"test", "datum.beyond"}, {"value", kBeyondColour}}, {{"value", kMeasuredColour}}});
-  points["fillOpacity"] = {{"value", 0.8}};
-  spec["marks"].push_back({{"type", "symbol"}, {"from", {{"data", "residual"}}}, {"encode", {{"enter", points}}}});
+  spec["marks"].push_back(pointMark("residual_points", "residual", "residual",
+                                    json::array({{{"test", "datum.beyond"}, {"value", kBeyondColour}}, {{"value", kMeasuredColour}}}),
+                                    d.measured));
+  addValidationLabel(spec, validation);
 
   const json solid = json::array({1, 0});
   std::vector<LegendEntry> legend{{"residual", "circle", kMeasuredColour, "transparent", solid}};
@@ -373,6 +419,13 @@ void parameterTable(Page& page, const json& channel) {
 
 std::string yesNo(const std::optional<bool>& b) { return b ? (*b ? "yes" : "no") : kDash; }
 
+// Where u dwarfs the residual, "within 1.5 u" says little: the page says so in a sentence
+// (the same words as the terminal, model/verdict_strength.hpp).
+void weakVerdictNote(Page& page, double u, double residual_rms, const std::string& unit) {
+  const std::string sentence = model::weakVerdictSentence(u, residual_rms, unit);
+  if (!sentence.empty()) page.html += "<p class=\"strength\"><strong>Weak verdict:</strong> " + esc(sentence) + "</p>\n";
+}
+
 void channelDiagnosis(Page& page, const json& d, const ChannelName& n) {
   const std::string unit = n.unit.empty() ? "" : " (" + n.unit + ")";
   const json& rms = object(d, "rms_residual");
@@ -384,12 +437,20 @@ void channelDiagnosis(Page& page, const json& d, const ChannelName& n) {
   };
   row("RMS residual, training" + unit, sig(number(rms, "training"), 3));
   row("RMS residual, validation" + unit, sig(number(rms, "validation"), 3));
-  row("standard uncertainty of measurement" + unit, sig(number(d, "u_measurement"), 3));
-  if (boolean(d, "within")) row("RMS residual within the measurement uncertainty", yesNo(boolean(d, "within")));
+  row("standard uncertainty of measurement u" + unit, sig(number(d, "u_measurement"), 3));
+  // The verdict judges the validation span's RMS, the training span's when there is none.
+  const bool on_validation = number(rms, "validation").has_value();
+  const std::optional<double> judged = on_validation ? number(rms, "validation") : number(rms, "training");
+  const std::string span_name = on_validation ? "validation" : "training";
+  if (boolean(d, "within")) row("RMS residual (" + span_name + ") within 1.5 u", yesNo(boolean(d, "within")));
+  const std::optional<double> u = number(d, "u_measurement");
+  if (u && judged) row("u / RMS residual (" + span_name + ")", model::ratioText(model::uOverResidual(*u, *judged)));
   row("Ljung\u2013Box Q (" + whole(number(lb, "lags")) + " lags)", sig(number(lb, "Q"), 4));
-  row("Ljung\u2013Box p", sig(number(lb, "p"), 2));
+  const std::optional<double> p = number(lb, "p");
+  row("Ljung\u2013Box p", p ? model::pValueText(*p) : kDash);
   row("residual white", yesNo(boolean(d, "white")));
   page.html += "</tbody>\n</table>\n";
+  if (u && judged) weakVerdictNote(page, *u, *judged, n.unit);
 
   const json& windows = array(d, "windows");
   constexpr std::size_t kMaxWindows = 10;
@@ -440,7 +501,7 @@ const json* findChannel(const json* diagnosis, const std::string& id) {
 
 std::string verdictText(const std::string& v) {
   if (v == "missing") return "an effect is missing from the model";
-  if (v == "nothing_missing") return "nothing is missing: the residual is within the measurement uncertainty";
+  if (v == "nothing_missing") return "nothing is missing: every residual is white and within 1.5 u of the measurement";
   if (v == "unexplained") return "the residual has structure that no candidate effect explains";
   return v.empty() ? kDash : v;
 }
@@ -507,6 +568,9 @@ void checkKind(const json& j, const char* expected, const char* what) {
                                 "\", expected \"" + expected + "\"");
 }
 
+// What only this page has: the weak-verdict note.
+constexpr const char* kModelStyle = ".strength { background: #fff6e5; border-left: 3px solid #e6a100; padding: .3em .7em; }\n";
+
 }  // namespace
 
 std::string modelReportHtml(const json& fit, const json* diagnosis, const std::string& vega_js_path) {
@@ -543,6 +607,14 @@ std::string modelReportHtml(const json& fit, const json* diagnosis, const std::s
     const auto fact = [&facts](const std::string& s) { facts += (facts.empty() ? "" : " \u00b7 ") + s; };
     if (const auto u = number(c, "u_measurement")) fact("u of measurement = " + withUnit(sig(*u, 3), n.unit));
     if (const auto s = number(c, "sigma")) fact("residual \u03c3 (fit) = " + withUnit(sig(*s, 3), n.unit));
+    // The residual a reader weighs against u: the validation RMSE, else the training RMSE.
+    const json& ind = object(c, "indicators");
+    const bool on_validation = number(object(ind, "validation"), "rmse").has_value();
+    const std::optional<double> judged = number(object(ind, on_validation ? "validation" : "training"), "rmse");
+    const std::optional<double> u_m = number(c, "u_measurement");
+    if (u_m && judged)
+      fact("u / " + std::string(on_validation ? "validation" : "training") +
+           " RMSE = " + model::ratioText(model::uOverResidual(*u_m, *judged)));
     std::string effects;
     for (const auto& e : array(c, "effects")) effects += (effects.empty() ? "" : ", ") + text(e, "id");
     fact("effects: " + (effects.empty() ? kDash : effects));
@@ -553,18 +625,22 @@ std::string modelReportHtml(const json& fit, const json* diagnosis, const std::s
       fact("before: " + (b.empty() ? kDash : b));
     }
     page.html += esc(facts) + "</p>\n";
+    if (u_m && judged) weakVerdictNote(page, *u_m, *judged, n.unit);
 
     const SeriesData d = seriesData(object(c, "series"));
     if (d.rows.empty()) {
       page.html += "<p class=\"note\">No series in the input: nothing to plot.</p>\n";
     } else {
-      std::string cap = "Measured (points), model (line) and the band model \u00b1 U";
-      if (!d.has_U) cap = "Measured (points) and model (line); the input has no U, so no band";
+      std::string cap = "Measured (points, each with its U as a bar), model (line, drawn over the points) and the band model \u00b1 U";
+      if (!d.has_U)
+        cap = "Measured (points) and model (line, drawn over the points); the input holds no U for " + n.label +
+              ", so the points have no error bars and the model no band";
       if (d.has_before) cap += "; dashed: the model before the effects just added";
       page.plot(fitPlotSpec(n, d, validation), cap + (validation ? "; shaded: validation window." : "."));
       page.plot(residualPlotSpec(n, d, validation),
                 "Residual = measured \u2212 model" +
-                    std::string(d.has_U ? "; band \u00b1 U; red points: |residual| > U." : "; the input has no U."));
+                    std::string(d.has_U ? "; band \u00b1 U; red points: |residual| > U."
+                                        : "; the input holds no U for " + n.label + ", so no band."));
     }
     indicatorTable(page, c, n);
     parameterTable(page, c);
@@ -588,7 +664,7 @@ std::string modelReportHtml(const json& fit, const json* diagnosis, const std::s
       "content=\"probeloop\">\n<title>" +
       esc("Error model fit" + std::string(diagnosis ? " and diagnosis" : "") +
           (text(fit, "model").empty() ? "" : " \u2014 " + text(fit, "model"))) +
-      "</title>\n<style>" + kStyle + "</style>\n</head>\n<body>\n";
+      "</title>\n<style>" + kStyle + kModelStyle + "</style>\n</head>\n<body>\n";
   out += page.html;
   out += "<script>\n" + vega + "\n</script>\n<script>" + kRender + "</script>\n</body>\n</html>\n";
   return out;

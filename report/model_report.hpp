@@ -10,11 +10,20 @@
 //   every plot is a declarative Vega spec (JSON in <script type="application/json">) that
 //   Vega renders as SVG when the page loads; there is no drawing code of our own.
 // - Plots: for each fit channel with a non-empty "series", two plots in this order:
-//   (1) measured (points), model prediction (line) with the ±U band around it (area: the
-//   measured point lies in the band exactly when |residual| <= U), the "before" prediction
-//   (dashed line) when predicted_before is present, against time in hours, the validation
-//   window shaded; (2) residual = measured − model (points, red beyond U) with the ±U
-//   band about zero. Plot k (1, 2, … in page order) is <div class="vega-plot" id="plot-k">
+//   (1) measured (points, each with its U from the series as a bar value ± U), model
+//   prediction (line) with the ±U band around it (area: the measured point lies in the band
+//   exactly when |residual| <= U), the "before" prediction (dashed line) when
+//   predicted_before is present, against time in hours, the validation window shaded;
+//   (2) residual = measured − model (points, red beyond U) with the ±U band about zero.
+//   Marks are named and drawn in this order: validation_window, band_area,
+//   model_before_line, error_bar_rules, measured_points (residual_points), model_line,
+//   validation_label: the model line lies over the
+//   points, and the label, centred over its window and not clipped, over everything. Above
+//   150 points they are smaller and translucent. A channel without U gets no bars and no
+//   band, and its captions say the input holds no U for it.
+// - Verdict strength: wherever the page says "within 1.5 u" (and in each fit channel's
+//   summary) it gives u / residual RMS, and the sentence of model/verdict_strength.hpp when
+//   u >= 2x the residual; p-values below 1e-4 read "< 1e-4". Plot k (1, 2, … in page order) is <div class="vega-plot" id="plot-k">
 //   with its spec in <script type="application/json" id="plot-k-spec">. The data values
 //   in a spec are the input's, unchanged (hours, residual and band are Vega formulas).
 // - Render errors: the page writes every script error and every Vega error into

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "model/verdict_strength.hpp"
 
 namespace probeloop::report {
 namespace {
@@ -83,6 +84,7 @@ json diagnosisJson() {
         {"rms_residual", {{"training", 2.0}, {"validation", 3.1}}},
         {"ljung_box", {{"Q", 812.0}, {"lags", 20}, {"p", 0.0}}},
         {"white", false},
+        {"within", false},
         {"windows", json::array({{{"from_s", 3600}, {"to_s", 9000}, {"peak", 5.2}, {"samples", 12}}})},
         {"cross_correlation", json::array({{{"input", "T_env_C"}, {"lag_s", 600}, {"r", 0.2}, {"significant", false}},
                                            {{"input", "c_rpm"}, {"lag_s", 2400}, {"r", -0.81}, {"significant", true}}})}}});
@@ -162,6 +164,140 @@ TEST_F(ModelReport, OneVegaSpecPerPlotCarryingTheInputValues) {
   EXPECT_NE(p2.find("datum.time_s / 3600"), std::string::npos);
   EXPECT_NE(html.find("renderer: 'svg'"), std::string::npos);
   EXPECT_NE(html.find("<div id=\"vega-errors\" class=\"errors\" role=\"alert\"></div>"), std::string::npos);
+}
+
+// Index of the mark named `name` in a spec's marks (drawing order), -1 when absent.
+int markIndex(const json& spec, const std::string& name) {
+  for (std::size_t i = 0; i < spec["marks"].size(); ++i)
+    if (spec["marks"][i].value("name", "") == name) return static_cast<int>(i);
+  return -1;
+}
+
+TEST_F(ModelReport, ModelLineIsDrawnOverThePointsAndEachPointCarriesItsU) {
+  const std::string html = modelReportHtml(fitJson(true), nullptr, vega_);
+  const json p1 = spec(html, 1);
+  const int band = markIndex(p1, "band_area"), bars = markIndex(p1, "error_bar_rules"), points = markIndex(p1, "measured_points"),
+            model = markIndex(p1, "model_line"), label = markIndex(p1, "validation_label");
+  ASSERT_GE(band, 0);
+  ASSERT_GE(bars, 0);
+  ASSERT_GE(points, 0);
+  ASSERT_GE(model, 0);
+  // SVG paints in document order: the later mark lies on top.
+  EXPECT_LT(band, bars);
+  EXPECT_LT(bars, points);
+  EXPECT_LT(points, model);
+  EXPECT_EQ(label, static_cast<int>(p1["marks"].size()) - 1);
+  // The model line is wider than the points' size suggests and not the points' colour.
+  const json& line = p1["marks"][model]["encode"]["enter"];
+  const json& dots = p1["marks"][points]["encode"]["enter"];
+  EXPECT_GE(line["strokeWidth"]["value"].get<double>(), 2.0);
+  EXPECT_NE(line["stroke"]["value"], dots["fill"]["value"]);
+  // The bars run from measured − U to measured + U of each row, U being the input's value.
+  const json bar_data = dataset(p1, "error_bars");
+  ASSERT_TRUE(bar_data.is_object());
+  EXPECT_EQ(bar_data["source"], "series");
+  EXPECT_NE(bar_data.dump().find("datum.measured - datum.U"), std::string::npos);
+  EXPECT_NE(bar_data.dump().find("datum.measured + datum.U"), std::string::npos);
+  EXPECT_EQ(p1["marks"][bars]["encode"]["enter"]["y"]["field"], "U_lo");
+  EXPECT_EQ(p1["marks"][bars]["encode"]["enter"]["y2"]["field"], "U_hi");
+  EXPECT_EQ(dataset(p1, "series")["values"][2]["U"], 2.2);
+  // The y scale reaches the ends of the bars, so no bar is cut.
+  EXPECT_NE(p1.dump().find("{\"data\":\"error_bars\",\"field\":\"U_hi\"}"), std::string::npos);
+  // The residual plot: its label too comes last, and its points over the band.
+  const json p2 = spec(html, 2);
+  EXPECT_LT(markIndex(p2, "band_area"), markIndex(p2, "residual_points"));
+  EXPECT_EQ(markIndex(p2, "validation_label"), static_cast<int>(p2["marks"].size()) - 1);
+}
+
+TEST_F(ModelReport, MarkNamesDifferFromDataSetNames) {
+  // Vega makes a data set of each named mark: a mark named like a data set is a parse error.
+  const std::string html = modelReportHtml(fitJson(true), nullptr, vega_);
+  for (int k = 1; k <= 4; ++k) {
+    const json s = spec(html, k);
+    for (const auto& m : s["marks"])
+      if (m.contains("name")) EXPECT_TRUE(dataset(s, m["name"]).is_null()) << "plot " << k << ": " << m["name"];
+  }
+}
+
+TEST_F(ModelReport, ValidationLabelIsCentredOverItsWindowAndNeverClipped) {
+  const json p1 = spec(modelReportHtml(fitJson(false), nullptr, vega_), 1);
+  const json& label = p1["marks"][markIndex(p1, "validation_label")];
+  EXPECT_EQ(label["clip"], false);
+  EXPECT_EQ(label["encode"]["enter"]["align"]["value"], "center");
+  EXPECT_NE(label["encode"]["enter"]["x"]["signal"].get<std::string>().find("datum.to_h"), std::string::npos);
+  // autosize "pad": the view grows to hold any mark that reaches beyond width × height.
+  EXPECT_EQ(p1["autosize"]["type"], "pad");
+}
+
+TEST_F(ModelReport, ManyPointsAreSmallerAndTranslucent) {
+  json fit = fitJson(false);
+  json& series = fit["channels"][0]["series"];
+  series = {{"time_s", json::array()}, {"measured", json::array()}, {"predicted", json::array()}, {"U", json::array()}};
+  for (int i = 0; i < 616; ++i) {
+    series["time_s"].push_back(60.0 * i);
+    series["measured"].push_back(0.01 * i);
+    series["predicted"].push_back(0.01 * i);
+    series["U"].push_back(2.2);
+  }
+  const std::string html = modelReportHtml(fit, nullptr, vega_);
+  const json many = spec(html, 1)["marks"][markIndex(spec(html, 1), "measured_points")]["encode"]["enter"];
+  const json few = spec(html, 3)["marks"][markIndex(spec(html, 3), "measured_points")]["encode"]["enter"];  // EZ0T: 5 points
+  EXPECT_LT(many["size"]["value"].get<double>(), few["size"]["value"].get<double>());
+  EXPECT_LT(many["fillOpacity"]["value"].get<double>(), few["fillOpacity"]["value"].get<double>());
+}
+
+TEST_F(ModelReport, AChannelWithoutUSaysSoInsteadOfDrawingNoBars) {
+  json fit = fitJson(false);
+  fit["channels"][0]["series"]["U"] = nullptr;
+  const std::string html = modelReportHtml(fit, nullptr, vega_);
+  EXPECT_EQ(markIndex(spec(html, 1), "error_bar_rules"), -1);
+  EXPECT_NE(html.find("the input holds no U for EY0C, so the points have no error bars"), std::string::npos);
+  EXPECT_GE(markIndex(spec(html, 3), "error_bar_rules"), 0);  // EZ0T still has its U
+}
+
+TEST(PValueText, BelowOneInTenThousandIsABoundNeverZero) {
+  EXPECT_EQ(model::pValueText(0.0), "< 1e-4");
+  EXPECT_EQ(model::pValueText(3e-7), "< 1e-4");
+  EXPECT_EQ(model::pValueText(0.012), "0.012");
+  EXPECT_EQ(model::pValueText(1e-4), "0.0001");
+  EXPECT_EQ(model::pValueText(0.5), "0.5");
+  EXPECT_EQ(model::pValueClause(0.0), "p < 1e-4");
+  EXPECT_EQ(model::pValueClause(0.012), "p = 0.012");
+}
+
+TEST_F(ModelReport, LjungBoxPOfZeroIsPrintedAsABound) {
+  const json d = diagnosisJson();  // p = 0 in the input
+  const std::string html = modelReportHtml(fitJson(true), &d, vega_);
+  EXPECT_NE(html.find("Ljung\u2013Box p</th><td class=\"num\">&lt; 1e-4</td>"), std::string::npos);
+  EXPECT_EQ(html.find("Ljung\u2013Box p</th><td class=\"num\">0</td>"), std::string::npos);
+}
+
+TEST(WeakVerdict, SentenceFromTwiceTheResidualOn) {
+  // u = 1.0 against RMS 0.5: exactly 2x.
+  EXPECT_EQ(model::weakVerdictSentence(1.0, 0.5, "um"),
+            "the measurement's uncertainty (u = 1 um) is 2.0\u00d7 the residual (RMS 0.5 um): the model cannot be judged "
+            "finer than u.");
+  EXPECT_EQ(model::weakVerdictSentence(1.0, 0.51, "um"), "");
+  EXPECT_EQ(model::weakVerdictSentence(1.0, 3.0, "um"), "");
+  EXPECT_NE(model::weakVerdictSentence(1.0, 0.0, "um").find("> 1000\u00d7"), std::string::npos);
+  EXPECT_EQ(model::ratioText(model::uOverResidual(1.1, 0.35)), "3.1");
+  EXPECT_EQ(model::ratioText(model::uOverResidual(25, 2)), "12");
+}
+
+TEST_F(ModelReport, StatesTheVerdictsStrengthWhereUDwarfsTheResidual) {
+  // Fit channels: u = 1.1 µm, validation RMSE 0.35 µm: u is 3.1x the residual.
+  const json d = diagnosisJson();  // EY0C: u = 1.1 µm against a validation RMS of 3.1 µm: 0.35x
+  const std::string html = modelReportHtml(fitJson(true), &d, vega_);
+  EXPECT_NE(html.find("u / validation RMSE = 3.1"), std::string::npos);
+  const std::string sentence =
+      "the measurement&#39;s uncertainty (u = 1.1 \u00b5m) is 3.1\u00d7 the residual (RMS 0.35 \u00b5m): the model "
+      "cannot be judged finer than u.";
+  EXPECT_EQ(count(html, sentence), 2u);  // EY0C's and EZ0T's fit summaries
+  // The diagnosis of EY0C: the ratio is shown, the sentence is not (u < 2x the residual).
+  EXPECT_NE(html.find("u / RMS residual (validation)</th><td class=\"num\">0.4</td>"), std::string::npos);
+  EXPECT_NE(html.find("RMS residual (validation) within 1.5 u"), std::string::npos);
+  EXPECT_EQ(count(html, "is 0.4\u00d7 the residual"), 0u);
+  EXPECT_EQ(count(html, "Weak verdict"), 2u);
 }
 
 TEST_F(ModelReport, TablesShowIndicatorsBeforeAfterParametersAndUnits) {

@@ -9,11 +9,11 @@ the simulator's injected truth (truth.json), not taken from the code under test.
 campaign hides nothing, and the answer must be "nothing missing". Then bad input, and the
 HTML report opened in headless Chromium. Needs $PROBELOOP and $PROBELOOP_SOURCE_DIR.
 """
-import csv, json, math, os, shlex, subprocess, sys, tempfile
+import csv, json, math, os, re, shlex, subprocess, sys, tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from checks import Checks, run_text_and_json  # noqa: E402
-from html_render import check as render_check  # noqa: E402
+from html_render import Node, TreeBuilder, check_dom, render  # noqa: E402
 
 PL = os.environ["PROBELOOP"]
 SRC = os.environ["PROBELOOP_SOURCE_DIR"]
@@ -187,15 +187,107 @@ if p.returncode == 0:
             check("force_feed: add and fit run", False, err + err2)
 
 # The HTML report of the last campaign with an added effect, opened in Chromium.
+
+
+def parse(dom):
+    tree = TreeBuilder()
+    tree.feed(dom)
+    tree.close()
+    return tree.root
+
+
+def mark_groups(svg):
+    """The Vega mark groups of one plot in SVG document order (= painting order): (name, kind, group)."""
+    out = []
+    for g in svg.walk():
+        cls = g.classes()
+        if g.tag == "g" and "role-mark" in cls:
+            kind = next((c[5:] for c in cls if c.startswith("mark-")), "?")
+            name = next((c for c in cls if not c.startswith(("mark-", "role-"))), "")
+            out.append((name, kind, g))
+    return out
+
+
+def texts_at(node, x=0.0, y=0.0, out=None):
+    """Every <text> with its position in the svg: the translates of its ancestors summed."""
+    out = [] if out is None else out
+    m = re.search(r"translate\(([-\d.e]+),\s*([-\d.e]+)\)", node.attrs.get("transform", ""))
+    if m:
+        x, y = x + float(m.group(1)), y + float(m.group(2))
+    if node.tag == "text":
+        out.append((node.text(), x, y, node.attrs))
+    for c in node.children:
+        if isinstance(c, Node):
+            texts_at(c, x, y, out)
+    return out
+
+
+def channel_sections(root):
+    return {next((h.text() for h in sec.walk() if h.tag == "h2"), "").split(" ")[0]: sec
+            for sec in root.walk() if sec.tag == "section" and "channel" in sec.classes()}
+
+
+def u_and_validation_rms(errors_csv, fit, channel):
+    """u = median(U)/2 from errors.csv, and the RMS of measured − model over the validation
+    span: the numbers the weak-verdict sentence must follow, recomputed outside the code."""
+    rows = list(csv.DictReader(l for l in open(errors_csv) if not l.startswith("#")))
+    U = sorted(float(r["U_" + channel]) for r in rows if float(r["U_" + channel]) > 0)
+    u = U[len(U) // 2] / 2
+    c = next(c for c in fit["channels"] if c["channel"] == channel)
+    s = c["series"]
+    res = [float(r[channel]) - p for r, t, p in zip(rows, s["time_s"], s["predicted"]) if t >= fit["validation"]["from_s"]]
+    return u, math.sqrt(sum(r * r for r in res) / len(res))
+
+
 out = f"{W}/door_step"
 if os.path.exists(f"{out}/model.yaml"):
-    rc, _, err = run("model", "fit", f"{out}/model.yaml", "--html", f"{out}/fit.html")
+    rc, _, err = run("model", "fit", f"{out}/model.yaml", "--html", f"{out}/fit.html", "--json", f"{out}/fit-page.json")
     check("fit --html writes the HTML", rc == 0 and os.path.exists(f"{out}/fit.html"), err)
     if rc == 0:
-        ok, detail = render_check(f"{out}/fit.html", 2 * len(CHANNELS))
-        check("the fit report's plots render in headless Chromium", ok, detail)
-    rc, _, err = run("model", "diagnose", f"{out}/model.yaml", "--html", f"{out}/diagnosis.html")
+        try:
+            dom = render(f"{out}/fit.html")[0]
+        except (RuntimeError, subprocess.TimeoutExpired) as e:
+            dom = ""
+            check("the fit report opens in headless Chromium", False, e)
+        ok, lines = check_dom(dom, 2 * len(CHANNELS))
+        check("the fit report's plots render in headless Chromium", ok, "\n".join(lines))
+        root = parse(dom)
+        plots = [d for d in root.walk() if d.tag == "div" and "vega-plot" in d.classes()]
+        fit_plots = [next((n for n in d.walk() if n.tag == "svg"), None) for d in plots[0::2]]
+        bars, order, labels = [], [], []
+        for svg in filter(None, fit_plots):
+            groups = mark_groups(svg)
+            names = [n for n, _, _ in groups]
+            bars.append(sum(1 for n, k, g in groups if n == "error_bar_rules" for x in g.walk() if x.tag in ("line", "path")))
+            order.append("measured_points" in names and "model_line" in names and names.index("measured_points") < names.index("model_line"))
+        for svg in filter(None, (next((n for n in d.walk() if n.tag == "svg"), None) for d in plots)):
+            w, h = float(svg.attrs.get("width", 0)), float(svg.attrs.get("height", 0))
+            for t, x, y, a in texts_at(svg):
+                if t == "validation":
+                    half = 0.6 * float(a.get("font-size", "11px").rstrip("px")) * len(t) / 2
+                    labels.append(half <= x <= w - half and 0 <= y <= h)
+        f = json.load(open(f"{out}/fit-page.json"))
+        # Every measured point with a U > 0 (the reference cycle's U is 0: exact by definition).
+        n_rows = [sum(1 for m, U in zip(c["series"]["measured"], c["series"]["U"]) if m is not None and U) for c in f["channels"]]
+        check(f"the fit plots draw one U bar per measured point with U > 0 ({n_rows})", len(bars) == len(CHANNELS) and bars == n_rows, bars)
+        check("the model line comes after the points in every fit plot's SVG (drawn on top)",
+              len(order) == len(CHANNELS) and all(order), order)
+        check("every 'validation' label lies inside its plot", len(labels) == 2 * len(CHANNELS) and all(labels), labels)
+        sections = channel_sections(root)
+        for ch in CHANNELS:
+            u, rms = u_and_validation_rms(f"{out}/eval/errors.csv", f, ch)
+            label = ch.rsplit("_", 1)[0]
+            text = sections[label].text() if label in sections else ""
+            weak = "the model cannot be judged finer than u" in text
+            if abs(u / rms - 2) > 0.05:  # away from the threshold, where rounding could tip it
+                check(f"{ch}: u {u:.3g} / validation RMS {rms:.3g} = {u / rms:.2f}: the weak-verdict sentence "
+                      f"{'shown' if u >= 2 * rms else 'absent'}", weak == (u >= 2 * rms), text[:600])
+            check(f"{ch}: the page states u / validation RMSE", f"u / validation RMSE = " in text, text[:400])
+    rc, text, err = run("model", "diagnose", f"{out}/model.yaml", "--html", f"{out}/diagnosis.html")
     check("diagnose --html writes the HTML", rc == 0 and os.path.exists(f"{out}/diagnosis.html"), err)
+    check("diagnose prints no 'p = 0'", re.search(r"p = 0(\s|,|\))", text) is None, text[:1500])
+    page = open(f"{out}/diagnosis.html").read() if rc == 0 else ""
+    check("the diagnosis page prints no p of 0", "Box p</th><td class=\"num\">0</td>" not in page)
 
 # Bad input: clear messages, nothing written.
 b = f"{W}/bad"

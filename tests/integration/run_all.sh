@@ -79,6 +79,7 @@ rm -rf "$W/d"
 "$PL" evaluate "$W/d/sphere_probe.log" --manifest "$W/p/plan.json" --out "$W/d/lc" > /dev/null
 "$PL" evaluate "$W/d/sphere_probe_dprnt.txt" --format fanuc --manifest "$W/p/plan.json" --out "$W/d/fa" > /dev/null
 "$PL" evaluate "$W/d/points.csv" --manifest "$W/p/plan.json" --out "$W/d/csv" --scene "$W/d/scene.gltf" > /dev/null
+check "the scene's legend page (scene.html) in Chromium" python3 "$SRC/tests/integration/scene_legend_check.py" "$W/d/scene.gltf"
 check "noisy campaign recovered within U (k=2)" python3 "$SRC/tests/integration/compare_errors.py" "$W/d/lc/errors.csv" "$W/d/truth.json" 0 0 --within-U
 "$PL" evaluate "$W/d/sphere_probe.log" --free-radius --manifest "$W/p/plan.json" --out "$W/d/free" > /dev/null
 check "free-radius centres also within U" python3 "$SRC/tests/integration/compare_errors.py" "$W/d/free/errors.csv" "$W/d/truth.json" 0 0 --within-U
