@@ -214,8 +214,11 @@ TEST_F(ModelReport, MarkNamesDifferFromDataSetNames) {
   const std::string html = modelReportHtml(fitJson(true), nullptr, vega_);
   for (int k = 1; k <= 4; ++k) {
     const json s = spec(html, k);
-    for (const auto& m : s["marks"])
-      if (m.contains("name")) EXPECT_TRUE(dataset(s, m["name"]).is_null()) << "plot " << k << ": " << m["name"];
+    for (const auto& m : s["marks"]) {
+      if (m.contains("name")) {
+        EXPECT_TRUE(dataset(s, m["name"]).is_null()) << "plot " << k << ": " << m["name"];
+      }
+    }
   }
 }
 
