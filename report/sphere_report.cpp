@@ -121,7 +121,7 @@ void header(Page& page, const json& eval, const sphere::Inputs* in, const parts:
                                                hoursAt(times.front()) + " to " + hoursAt(times.back()) +
                                                " on the log's clock";
   page.html += "<header>\n<h1>" + esc(title) + "</h1>\n<p>The location errors of the C axis measured with the "
-               "sphere artifact (seed 004 Ch. 5): every cycle probes the spheres at their C positions, fits their "
+               "sphere artifact (Blaser 2020, ETH Diss. 26709, Ch. 5): every cycle probes the spheres at their C positions, fits their "
                "centres and turns the centres' change since the reference cycle into EX0C, EY0C, EZ0T, ER0T, EA0C, "
                "EB0C and EC0C (Eqs. 5.4\u20135.10; signs: docs/conventions.md), each with its GUM budget "
                "(docs/uncertainty.md).</p>\n<table class=\"meta\">\n";
@@ -307,7 +307,7 @@ void scatterAndRepeatability(Page& page, const json& eval) {
                  esc(orDash(text(s, "used"))) + ".</p>\n";
   const json& rep = array(eval, "centre_repeatability");
   if (rep.empty()) return;
-  page.html += "<h3>Sphere-centre repeatability over the cycles (seed 004 Table 5.3 statistics)</h3>\n<p "
+  page.html += "<h3>Sphere-centre repeatability over the cycles (Blaser 2020, Table 5.3 statistics)</h3>\n<p "
                "class=\"note\">U = 2 s for one measurement and 2 s/\u221an for the mean of n; 3D = root-sum-square "
                "of X, Y, Z. Over a campaign the drift between cycles is included.</p>\n<table class=\"repeatability\">"
                "\n<thead><tr>" + th("position") + th("cycles", true) + th("s X, Y, Z (\u00b5m)", true) +

@@ -13,14 +13,14 @@ namespace probeloop::report::sphere {
 using namespace web;
 
 const ErrorInfo kErrors[7] = {
-    {"EX0C_um", "EX0C", "\u00b5m", "position of the C axis in X", "seed 004 Eq. 5.4"},
-    {"EY0C_um", "EY0C", "\u00b5m", "position of the C axis in Y", "seed 004 Eq. 5.5"},
-    {"EZ0T_um", "EZ0T", "\u00b5m", "height of the table surface (mean sphere-centre Z)", "seed 004 Eq. 5.6"},
-    {"ER0T_um", "ER0T", "\u00b5m", "radial growth of the table at d/2", "seed 004 Eq. 5.7"},
-    {"EA0C_urad", "EA0C", "\u00b5rad", "tilt of the C axis about X (+Y side rises)", "seed 004 Eq. 5.8"},
-    {"EB0C_urad", "EB0C", "\u00b5rad", "tilt of the C axis about Y (\u2212X side rises)", "seed 004 Eq. 5.9"},
+    {"EX0C_um", "EX0C", "\u00b5m", "position of the C axis in X", "Blaser 2020, Eq. 5.4"},
+    {"EY0C_um", "EY0C", "\u00b5m", "position of the C axis in Y", "Blaser 2020, Eq. 5.5"},
+    {"EZ0T_um", "EZ0T", "\u00b5m", "height of the table surface (mean sphere-centre Z)", "Blaser 2020, Eq. 5.6"},
+    {"ER0T_um", "ER0T", "\u00b5m", "radial growth of the table at d/2", "Blaser 2020, Eq. 5.7"},
+    {"EA0C_urad", "EA0C", "\u00b5rad", "tilt of the C axis about X (+Y side rises)", "Blaser 2020, Eq. 5.8"},
+    {"EB0C_urad", "EB0C", "\u00b5rad", "tilt of the C axis about Y (\u2212X side rises)", "Blaser 2020, Eq. 5.9"},
     {"EC0C_urad", "EC0C", "\u00b5rad", "angular position of the C axis (table turned clockwise seen from +Z)",
-     "seed 004 Eq. 5.10"},
+     "Blaser 2020, Eq. 5.10"},
 };
 
 namespace {
