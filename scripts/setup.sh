@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 
 packages=(cmake g++ make python3 libeigen3-dev libyaml-cpp-dev nlohmann-json3-dev libcli11-dev
           libtinygltf-dev libgtest-dev libcgal-dev libgmp-dev libmpfr-dev libceres-dev libboost-dev linuxcnc-uspace
-          libjs-vega libjs-three chromium libxml2-dev libxml2-utils libsqlite3-dev ninja-build python3-yaml)
+          libjs-vega libjs-three chromium libxml2-dev libxml2-utils libsqlite3-dev ninja-build python3-yaml ccache)
 command -v node >/dev/null 2>&1 || packages+=(nodejs)
 command -v npm >/dev/null 2>&1 || packages+=(npm)
 
