@@ -14,6 +14,7 @@
 #include "report/sphere_report.hpp"
 #include "report/sw_report.hpp"
 #include "report/ttp_report.hpp"
+#include "report/scene_legend.hpp"
 #include "report/ttp_scene.hpp"
 
 namespace probeloop::cli {
@@ -55,13 +56,15 @@ int runTtp(TtpArgs a) {
   }
 
   // Both outputs are made in memory first: an error in either leaves no file written.
-  std::string html, gltf;
+  std::string html, gltf, legend;
   if (!a.html.empty())
     html = report::thermalTestPieceReportHtml(evaluation, second ? &*second : nullptr, r_test ? &*r_test : nullptr,
                                               report::defaultVegaPath(), a.options);
   if (!a.scene.empty()) {
     const parts::PlanManifest manifest = parts::readManifest(a.manifest);
     gltf = naming(a.evaluation, [&] { return report::thermalTestPieceSceneGltf(manifest, evaluation, a.exaggeration); });
+    // The page that numbers the scene's colours, as `evaluate --scene` writes it beside a scene.
+    legend = report::sceneLegendHtml(gltf, std::filesystem::path(a.scene).filename().string());
   }
 
   if (!a.html.empty()) {
@@ -74,6 +77,9 @@ int runTtp(TtpArgs a) {
     writeFileAtomic(a.scene, gltf);
     std::printf("Wrote %s (glTF scene of %s, deviation vectors x%g)\n", a.scene.c_str(), a.manifest.c_str(),
                 a.exaggeration);
+    writeFileAtomic(report::sceneLegendPath(a.scene), legend);
+    std::printf("Wrote %s (the scene's colour scale in um, its exaggeration and objects)\n",
+                report::sceneLegendPath(a.scene).c_str());
   }
   return 0;
 }

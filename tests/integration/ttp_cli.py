@@ -298,6 +298,10 @@ if code == 0:
         check("the test piece's scene passes the Khronos validator", p.returncode == 0, p.stdout + p.stderr)
     else:
         check("gltf-validator installed (scripts/setup.sh)", False)
+    p = subprocess.run([sys.executable, f"{SRC}/tests/integration/scene_legend_check.py", f"{W}/scene.gltf"],
+                       capture_output=True, text=True)
+    check("report ttp --scene also writes the scene's legend page (scene.html), checked in Chromium against the scene",
+          p.returncode == 0, p.stdout[-1500:] + p.stderr[-500:])
 
 shutil.rmtree(W, ignore_errors=True) if check.failed == 0 else print(f"     (outputs kept in {W})")
 check.finish()
