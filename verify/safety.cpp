@@ -331,7 +331,7 @@ class Checker : public gcode::MachineInterface, public gcode::ProbeBranching {
   // checked, it is refused (the interpreter refuses it first; this is the second guard). The
   // interpreter adds the file:line, and `check` exits 2: the program cannot be evaluated.
   static const gcode::MachinePosition& requireFinite(const gcode::MachinePosition& to) {
-    if (!to.xyz_mm.allFinite() || !std::isfinite(to.b_deg) || !std::isfinite(to.c_deg))
+    if (!to.xyz_mm.allFinite() || !std::isfinite(to.a_deg) || !std::isfinite(to.b_deg) || !std::isfinite(to.c_deg))
       throw InputError("", 0, "a move to a coordinate that is not a finite number: the program cannot be checked");
     return to;
   }
@@ -601,6 +601,7 @@ class Checker : public gcode::MachineInterface, public gcode::ProbeBranching {
         add("travel", std::string(n) + " = " + fmt(v) + " deg is outside the " + n + " travel", tip(to),
             std::string(n) + " travel [" + fmt(a.min_deg) + ", " + fmt(a.max_deg) + "] deg of " + m_.file);
     };
+    rotary(m_.a, to.a_deg, pos_.a_deg, "A");
     rotary(m_.b, to.b_deg, pos_.b_deg, "B");
     rotary(m_.c, to.c_deg, pos_.c_deg, "C");
   }
@@ -617,7 +618,9 @@ class Checker : public gcode::MachineInterface, public gcode::ProbeBranching {
     const Tool& tool = toolOf(tool_);
     Motion mo{tip(pos_), tip(to), pos_.c_deg, to.c_deg};
     const bool rotary = std::fabs(to.c_deg - pos_.c_deg) > 1e-9;
-    const bool tilt = std::fabs(to.b_deg - pos_.b_deg) > 1e-9;
+    const bool a_moves = std::fabs(to.a_deg - pos_.a_deg) > 1e-9;
+    const bool tilt = std::fabs(to.b_deg - pos_.b_deg) > 1e-9 || a_moves;
+    const char* tilt_name = std::fabs(to.b_deg - pos_.b_deg) > 1e-9 ? "B" : "A";
     const bool cutting = is_feed && tool.cutter && rpm_ != 0;
     // A table turning many times under a still tool sweeps the same ring: one turn.
     if (rotary && (mo.b - mo.a).norm() < 1e-9 && std::fabs(mo.c1 - mo.c0) > 360)
