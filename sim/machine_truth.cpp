@@ -17,6 +17,8 @@ bool ErrorVector::any() const {
     if (v != 0) return true;
   for (double v : scale_um_per_mm)
     if (v != 0) return true;
+  for (double v : tilt_location)
+    if (v != 0) return true;
   return false;
 }
 
@@ -56,6 +58,13 @@ ErrorVector readErrorVector(YamlMap& m, const std::string& suffix) {
   for (int a = 0; a < 3; ++a) e.tool_um[a] = m.numberOr(std::string(tool[a]) + suffix, 0.0);
   const char* scale[] = {"EXX_um_per_mm", "EYY_um_per_mm", "EZZ_um_per_mm"};
   for (int a = 0; a < 3; ++a) e.scale_um_per_mm[a] = m.numberOr(std::string(scale[a]) + suffix, 0.0);
+  const char* comp[6] = {"X", "Y", "Z", "A", "B", "C"};
+  for (int k = 0; k < 6; ++k) {
+    const std::string unit = k < 3 ? "_um" : "_urad";
+    const std::string b = std::string("E") + comp[k] + "0B" + unit + suffix, a = std::string("E") + comp[k] + "0A" + unit + suffix;
+    if (m.has(b) && m.has(a)) m.fail(a, "the tilting axis is B or A, not both (" + b + " is given)");
+    e.tilt_location[static_cast<std::size_t>(k)] = m.numberOr(b, 0.0) + m.numberOr(a, 0.0);
+  }
   return e;
 }
 

@@ -30,6 +30,10 @@ struct ErrorVector {
   // (um per mm of travel; a heated ball screw stretches its axis's scale: seed 000's thermal
   // position error e_pt, which grows with the distance).
   std::array<double, 3> scale_um_per_mm{};  // EXX_um_per_mm, EYY_um_per_mm, EZZ_um_per_mm
+  // Location errors of the tilting axis (B or A, issue 33), right-hand about +X +Y +Z as
+  // ISO 230-7 counts them, at its axis line: EX0B_um, EY0B_um, EZ0B_um, EA0B_urad, EB0B_urad,
+  // EC0B_urad (or the same with A). The table with C and the artifact rides on it.
+  std::array<double, 6> tilt_location{};
   bool any() const;
 };
 
