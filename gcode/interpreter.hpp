@@ -1,6 +1,6 @@
 // Interpreter of the G-code the planner emits, in both dialects (LinuxCNC RS274NGC and
 // Fanuc macro B): modal state, G0/G1/G2/G3 (XY plane), G38.2/G38.3 and G31 probing, G4,
-// T/M6, G43/G49, M3/M4/M5 with S, M8/M9, G10 L2, G53, G54-G59, rotary axes B and C,
+// T/M6, G43/G49, M3/M4/M5 with S, M8/M9, G10 L2, G53, G54-G59, rotary axes A, B and C,
 // #-parameters (numbered, and LinuxCNC named #<...>), expressions with [ ], functions and
 // comparisons, LinuxCNC o-word while/if/elseif/else and Fanuc WHILE/DO/END, IF..GOTO,
 // IF..THEN, GOTO, #3000 alarms, LinuxCNC LOGOPEN/LOG/LOGCLOSE/ABORT and Fanuc
@@ -29,7 +29,7 @@ enum class ProgramDialect { LinuxCnc, FanucMacroB };
 
 struct MachinePosition {
   Eigen::Vector3d xyz_mm = Eigen::Vector3d::Zero();  // gauge line, machine coordinates
-  double b_deg = 0, c_deg = 0;
+  double a_deg = 0, b_deg = 0, c_deg = 0;
 };
 
 enum class ProbeMode {

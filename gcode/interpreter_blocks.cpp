@@ -22,7 +22,7 @@ bool Execution::block(const std::string& code) {
     if (c.peek() == '=') fail("unexpected '=' in '" + code + "'");
     const std::size_t value_at = c.i;
     const double v = wordValue(c);
-    static const std::string lengths = "XYZBCIJR";
+    static const std::string lengths = "XYZABCIJR";
     if (in_.dialect_ == ProgramDialect::FanucMacroB && lengths.find(letter) != std::string::npos && v != 0 &&
         code.substr(value_at, c.i - value_at).find_first_of(".#[") == std::string::npos)
       fail(std::string("'") + letter + code.substr(value_at, c.i - value_at) +
@@ -32,7 +32,7 @@ bool Execution::block(const std::string& code) {
     else if (letter == 'M') w.m.push_back(v);
     else if (letter == 'N') continue;
     else {
-      static const std::string allowed = "XYZBCFSTHPLIJR";
+      static const std::string allowed = "XYZABCFSTHPLIJR";
       // E: the analog input of LinuxCNC's M66 E<n> L0 (execute refuses it anywhere else).
       const bool analog_input = letter == 'E' && in_.dialect_ == ProgramDialect::LinuxCnc;
       if (allowed.find(letter) == std::string::npos && !analog_input)
@@ -122,7 +122,7 @@ bool Execution::execute(Words& w) {
   }
   // A new S while the spindle turns takes effect at once.
   if (w.has('S') && !spindle_word && spindle_dir_ != 0) m_.spindle(spindle_dir_ * spindle_rpm_);
-  const char ax[] = {'X', 'Y', 'Z', 'B', 'C'};
+  const char ax[] = {'X', 'Y', 'Z', 'A', 'B', 'C'};
   if (g10) {
     if (!w.has('L') || !w.has('P') || wholeWord(w, 'L', 0, 99) != 2)
       fail("only G10 L2 Pn (set a work offset) is modelled");
@@ -132,7 +132,7 @@ bool Execution::execute(Words& w) {
         fail("G10 L2 P0 is the external offset on a Fanuc control; it is not modelled");
       p = wcs_;
     }
-    for (int a = 0; a < 5; ++a)
+    for (int a = 0; a < 6; ++a)
       if (w.has(ax[a])) offsets_[p][a] = w.take(ax[a]);
     finishWords(w);
     return end;

@@ -115,7 +115,7 @@ class Execution {
   bool absolute_ = true;
   double feed_ = 0;
   int wcs_ = 1;
-  std::array<std::array<double, 5>, 7> offsets_{};  // [1..6] x y z b c
+  std::array<std::array<double, 6>, 7> offsets_{};  // [1..6] x y z a b c
   double tool_length_ = 0;
   int tool_in_spindle_ = 0, tool_selected_ = 0;
   double spindle_rpm_ = 0;
@@ -295,7 +295,7 @@ class Execution {
 
   static std::string fmtG(double g);
 
-  std::array<double, 5> activeOffset() const;
+  std::array<double, 6> activeOffset() const;
 
   MachinePosition target(Words& w, bool machine_coords);
 

@@ -59,7 +59,7 @@ InterpreterResult Execution::continueAfterProbe(const ProbeOutcome& other, Probe
   return runFrom(pc_ + 1);
 }
 
-std::array<double, 5> Execution::activeOffset() const {
+std::array<double, 6> Execution::activeOffset() const {
   auto o = offsets_[static_cast<std::size_t>(wcs_)];
   o[2] += tool_length_;
   return o;
@@ -67,12 +67,12 @@ std::array<double, 5> Execution::activeOffset() const {
 
 MachinePosition Execution::target(Words& w, bool machine_coords) {
   MachinePosition t = pos_;
-  const auto off = machine_coords ? std::array<double, 5>{} : activeOffset();
+  const auto off = machine_coords ? std::array<double, 6>{} : activeOffset();
   if (machine_coords && !absolute_) fail("G53 with G91 is not allowed");
-  double* dst[] = {&t.xyz_mm.x(), &t.xyz_mm.y(), &t.xyz_mm.z(), &t.b_deg, &t.c_deg};
-  const double cur[] = {pos_.xyz_mm.x(), pos_.xyz_mm.y(), pos_.xyz_mm.z(), pos_.b_deg, pos_.c_deg};
-  const char ax[] = {'X', 'Y', 'Z', 'B', 'C'};
-  for (int a = 0; a < 5; ++a) {
+  double* dst[] = {&t.xyz_mm.x(), &t.xyz_mm.y(), &t.xyz_mm.z(), &t.a_deg, &t.b_deg, &t.c_deg};
+  const double cur[] = {pos_.xyz_mm.x(), pos_.xyz_mm.y(), pos_.xyz_mm.z(), pos_.a_deg, pos_.b_deg, pos_.c_deg};
+  const char ax[] = {'X', 'Y', 'Z', 'A', 'B', 'C'};
+  for (int a = 0; a < 6; ++a) {
     if (!w.has(ax[a])) continue;
     const double v = w.take(ax[a]);
     *dst[a] = absolute_ ? v + off[static_cast<std::size_t>(a)] : cur[a] + v;
@@ -88,8 +88,18 @@ void Execution::setProbeResult(const ProbeOutcome& r) {
   params_[5061] = r.stop.xyz_mm.x() - off[0];
   params_[5062] = r.stop.xyz_mm.y() - off[1];
   params_[5063] = r.stop.xyz_mm.z() - off[2];
-  params_[5064] = r.stop.b_deg - off[3];
-  params_[5065] = r.stop.c_deg - off[4];
+  if (in_.dialect_ == ProgramDialect::LinuxCnc) {
+    // LinuxCNC numbers the probed position by axis letter: #5061..#5069 = X Y Z A B C U V W.
+    params_[5064] = r.stop.a_deg - off[3];
+    params_[5065] = r.stop.b_deg - off[4];
+    params_[5066] = r.stop.c_deg - off[5];
+  } else {
+    // Fanuc numbers the skip position by the control's axis order (#5061 + axis - 1): the
+    // X Y Z B C of the NMV 5000. An A/C Fanuc control would read A in #5064; no program we
+    // emit reads a rotary skip position.
+    params_[5064] = r.stop.b_deg - off[4];
+    params_[5065] = r.stop.c_deg - off[5];
+  }
   pos_ = r.stop;
 }
 

@@ -214,6 +214,25 @@ TEST(Interpreter, WorkOffsetsToolLengthAndMachineCoordinates) {
   EXPECT_EQ(r.targets[2].xyz_mm, Eigen::Vector3d(102, -48, 400));
 }
 
+// The A axis (issue 33): its work offset, absolute and incremental moves, and the probed
+// position in LinuxCNC's numbering (#5064 A, #5065 B, #5066 C).
+TEST(Interpreter, TheAAxisMovesWithItsOffsetAndItsProbedPosition) {
+  Recorder r;
+  r.contact_x = 5;
+  Interpreter in(ProgramDialect::LinuxCnc, "t.ngc",
+                 "G10 L2 P1 A2 B0 C10\nG54\nG0 A-30\nG91 G0 A5\nG90\nG0 B7 C20\nG38.2 X6 F100\nM2\n");
+  in.run(r);
+  ASSERT_EQ(r.targets.size(), 4u);
+  EXPECT_EQ(r.targets[0].a_deg, -28);  // -30 + the offset's 2
+  EXPECT_EQ(r.targets[1].a_deg, -23);  // incremental: no offset again
+  EXPECT_EQ(r.targets[2].a_deg, -23);
+  EXPECT_EQ(r.targets[2].b_deg, 7);
+  EXPECT_EQ(r.targets[2].c_deg, 30);
+  EXPECT_EQ(in.parameter(5064), -25);
+  EXPECT_EQ(in.parameter(5065), 7);
+  EXPECT_EQ(in.parameter(5066), 20);
+}
+
 // Bad input: every refusal names the file and line and what is not modelled.
 void expectInputError(ProgramDialect d, const std::string& text, const std::string& want) {
   Recorder r;
@@ -242,6 +261,7 @@ TEST(Interpreter, RefusesWhatItDoesNotModelWithTheLine) {
   expectInputError(ProgramDialect::LinuxCnc, "#1 = [-8 ** 0.5]\n", "bad.ngc:1: a negative number to a non-integer power");
   expectInputError(ProgramDialect::LinuxCnc, "T1.5 M6\n", "bad.ngc:1: T1.5: expected a whole number");
   expectInputError(ProgramDialect::FanucMacroB, "G0 X10\n", "bad.ngc:1: 'X10' has no decimal point");
+  expectInputError(ProgramDialect::FanucMacroB, "G0 A30\n", "bad.ngc:1: 'A30' has no decimal point");
   expectInputError(ProgramDialect::FanucMacroB, "WHILE [1 LT 2] DO\nEND1\n", "bad.ngc:1: WHILE [..] DOm needs m");
   expectInputError(ProgramDialect::FanucMacroB, "N12345678 G0 X1.\n", "bad.ngc:1: label N12345678 is not a number");
   expectInputError(ProgramDialect::LinuxCnc, "T5 M6\nG43\n", "bad.ngc:2: no tool 5");

@@ -41,6 +41,7 @@ struct ProbeProgram {
   std::string title;
   std::vector<std::string> header;  // comment lines at the top
   int work_offset = 6;              // 1..6 = G54..G59, zeroed by the program
+  bool has_a_axis = false;
   bool has_b_axis = false;
   std::string log_file;             // LinuxCNC LOGOPEN name; Fanuc writes to its DPRNT device
   int cycles = 1;

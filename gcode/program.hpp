@@ -24,6 +24,7 @@ struct RapidMachineZ { double z_mm; };
 // G0 of a rotary axis alone (indexing at its positioning speed).
 struct RotateC { double c_deg; };
 struct RotateB { double b_deg; };
+struct RotateA { double a_deg; };  // a cradle tilting about X (a table-table A/C machine)
 // T.. M6, then G43 H<tool> (length offset on) or G49 (the empty spindle).
 struct ToolChange { int tool; bool apply_length_offset; };
 // A move near the part that must not touch it: contact stops the program.
@@ -50,7 +51,7 @@ struct LoopBegin { int count; std::string name; };
 struct LoopEnd {};
 
 using Op = std::variant<Comment, Rapid, RapidMachineZ, RotateC, ToolChange, ProtectedMove, ProbeMove, Dwell,
-                        RotateB, Spindle, Coolant, Feed, TurnC, LoopBegin, LoopEnd>;
+                        RotateB, Spindle, Coolant, Feed, TurnC, LoopBegin, LoopEnd, RotateA>;
 
 // Whether every number of the op is finite (a NaN or an infinity must never reach a program).
 bool allFinite(const Op& op);
@@ -61,6 +62,7 @@ struct Program {
   std::vector<std::string> header;  // comment lines at the top
   int number = 1000;                // Fanuc O-number
   int work_offset = 6;              // 1..6 = G54..G59, zeroed by the program
+  bool has_a_axis = false;  // the work offset zeroes the rotary axes the machine has
   bool has_b_axis = false;
   bool has_c_axis = true;  // false: a 3-axis machine (no C word in the work offset)
   // Programs that probe: LinuxCNC LOGOPEN name (Fanuc writes to its DPRNT device); the log's

@@ -8,6 +8,7 @@
 
 #include "core/error.hpp"
 #include "gcode/interpreter.hpp"
+#include "gcode/probe_program.hpp"
 #include "gcode/program.hpp"
 
 namespace probeloop::gcode {
@@ -95,6 +96,37 @@ TEST(ProgramWriter, FanucLines) {
             std::string::npos)
       << s;
   EXPECT_NE(s.find("M30\n%\n"), std::string::npos);
+}
+
+// A table-table A/C machine (issue 33): the A word as B's, the work offset zeroing A, and our
+// interpreter handing A to the machine in both dialects.
+TEST(ProgramWriter, TheAAxisIsWrittenAndReadLikeB) {
+  Program p;
+  p.title = "a";
+  p.has_a_axis = true;
+  p.ops = {RotateA{-30}, RotateC{90}, RotateA{12.5}};
+  const std::string l = writeLinuxCnc(p), f = writeFanucMacroB(p);
+  for (const auto& s : {l, f}) {
+    EXPECT_NE(s.find("G10 L2 P6 X0 Y0 Z0 A0 C0\nG59\nG0 A-30.000\nG0 C90.000\nG0 A12.500\n"), std::string::npos) << s;
+  }
+  EXPECT_FALSE(allFinite(Op{RotateA{NAN}}));
+  for (auto d : {ProgramDialect::LinuxCnc, ProgramDialect::FanucMacroB}) {
+    Counter c;
+    Interpreter in(d, "a", d == ProgramDialect::LinuxCnc ? l : f);
+    EXPECT_TRUE(in.run(c).ended);
+    EXPECT_EQ(c.rapids, 3);
+    EXPECT_EQ(c.at.a_deg, 12.5);
+    EXPECT_EQ(c.at.c_deg, 90);
+    EXPECT_EQ(c.at.b_deg, 0);
+  }
+  // A ProbeProgram zeroes A in its work offset too; without A nothing changes.
+  ProbeProgram pp;
+  pp.title = "pa";
+  pp.log_file = "pa.log";
+  pp.has_a_axis = true;
+  EXPECT_NE(writeLinuxCnc(pp).find("G10 L2 P6 X0 Y0 Z0 A0 C0\n"), std::string::npos);
+  pp.has_a_axis = false;
+  EXPECT_NE(writeFanucMacroB(pp).find("G10 L2 P6 X0 Y0 Z0 C0\n"), std::string::npos);
 }
 
 TEST(ProgramWriter, NestedLoopsUseOneCounterPerLevel) {

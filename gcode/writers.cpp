@@ -52,7 +52,9 @@ std::string clean(std::string s) {
   return s;
 }
 
-std::string offsetAxes(bool b, bool c = true) { return std::string(" X0 Y0 Z0") + (b ? " B0" : "") + (c ? " C0" : ""); }
+std::string offsetAxes(bool a, bool b, bool c = true) {
+  return std::string(" X0 Y0 Z0") + (a ? " A0" : "") + (b ? " B0" : "") + (c ? " C0" : "");
+}
 
 const char* wcs(int n) {
   static const char* names[] = {"G54", "G55", "G56", "G57", "G58", "G59"};
@@ -63,6 +65,7 @@ const char* wcs(int n) {
 std::string rapidLine(const Rapid& r) { return "G0" + axes(r) + "\n"; }
 std::string rotateLine(const RotateC& r) { return "G0 C" + n3(r.c_deg) + "\n"; }
 std::string rotateBLine(const RotateB& r) { return "G0 B" + n3(r.b_deg) + "\n"; }
+std::string rotateALine(const RotateA& r) { return "G0 A" + n3(r.a_deg) + "\n"; }
 // Spindle speeds are whole rpm on every control.
 std::string spindleLine(const Spindle& s) {
   return s.rpm > 0 ? "S" + formatNumber(s.rpm, 0) + " M3\n" : std::string("M5\n");
@@ -111,6 +114,7 @@ struct LinuxWriter {
         },
         [&](const Dwell& d) { out << "G4 P" << n3(d.seconds) << "\n"; },
         [&](const RotateB& r) { out << rotateBLine(r); },
+        [&](const RotateA& r) { out << rotateALine(r); },
         [&](const Spindle& sp) { out << spindleLine(sp); },
         [&](const Coolant& c) { out << coolantLine(c); },
         [&](const Feed& f) { out << feedLine(f); },
@@ -163,6 +167,7 @@ struct FanucWriter {
         },
         [&](const Dwell& d) { out << "G4 X" << n3(d.seconds) << "\n"; },
         [&](const RotateB& r) { out << rotateBLine(r); },
+        [&](const RotateA& r) { out << rotateALine(r); },
         [&](const Spindle& sp) { out << spindleLine(sp); },
         [&](const Coolant& c) { out << coolantLine(c); },
         [&](const Feed& f) { out << feedLine(f); },
@@ -220,6 +225,7 @@ bool allFinite(const Op& op) {
                         [&](const RapidMachineZ& r) { return f({r.z_mm}); },
                         [&](const RotateC& r) { return f({r.c_deg}); },
                         [&](const RotateB& r) { return f({r.b_deg}); },
+                        [&](const RotateA& r) { return f({r.a_deg}); },
                         [&](const ToolChange&) { return true; },
                         [&](const ProtectedMove& m) { return f({m.x, m.y, m.z, m.feed_mm_per_min}); },
                         [&](const ProbeMove& m) { return f({m.x, m.y, m.z, m.feed_mm_per_min}); },
@@ -243,7 +249,7 @@ std::string writeLinuxCnc(const Program& p) {
   o << "(" << clean(p.title) << ")\n";
   for (const auto& h : p.header) o << "(" << clean(h) << ")\n";
   o << "G21 G90 G17 G40 G49 G80 G94\n";
-  o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_b_axis, p.has_c_axis) << "\n";
+  o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_a_axis, p.has_b_axis, p.has_c_axis) << "\n";
   o << wcs(p.work_offset) << "\n";
   if (!p.log_file.empty()) {
     o << "(LOGOPEN," << p.log_file << ")\n";
@@ -263,7 +269,7 @@ std::string writeFanucMacroB(const Program& p) {
   o << "O" << p.number << " (" << FanucWriter::upper(clean(p.title)) << ")\n";
   for (const auto& h : p.header) o << "(" << FanucWriter::upper(clean(h)) << ")\n";
   o << "G21 G90 G17 G40 G49 G80 G94\n";
-  o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_b_axis, p.has_c_axis) << "\n";
+  o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_a_axis, p.has_b_axis, p.has_c_axis) << "\n";
   o << wcs(p.work_offset) << "\n";
   if (!p.log_file.empty()) {
     o << "POPEN\n";
@@ -347,7 +353,7 @@ std::string writeLinuxCnc(const ProbeProgram& p) {
       << " L0 -> #5399] after each probing move, logged as the 8th field: the inputs logger's clock in s)\n";
   }
   o << "G21 G90 G17 G40 G49 G80 G94\n";
-  o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_b_axis) << "\n";
+  o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_a_axis, p.has_b_axis) << "\n";
   o << wcs(p.work_offset) << "\n";
   o << "(LOGOPEN," << p.log_file << ")\n";
   for (const auto& op : p.before_cycles) w.op(op);
@@ -375,7 +381,7 @@ std::string writeFanucMacroB(const ProbeProgram& p, int program_number) {
                                                  " (written by FOCAS cnc_wrmacro)"))
     o << "(" << FanucWriter::upper(clean(h)) << ")\n";
   o << "G21 G90 G17 G40 G49 G80 G94\n";
-  o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_b_axis) << "\n";
+  o << "G10 L2 P" << p.work_offset << offsetAxes(p.has_a_axis, p.has_b_axis) << "\n";
   o << wcs(p.work_offset) << "\n";
   o << "POPEN\n";
   o << "DPRNT[START*#3011[80]*#3012[60]]\n";  // the clock when the program starts

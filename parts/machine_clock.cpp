@@ -13,9 +13,9 @@ double rotaryIndexSeconds(double delta_deg, const RotaryAxis& ax) {
   return std::fabs(delta_deg) / (ax.max_speed_rpm * 360.0) * 60.0;
 }
 
-double rapidSeconds(const Machine& m, const Eigen::Vector3d& d, double db, double dc) {
+double rapidSeconds(const Machine& m, const Eigen::Vector3d& d, double db, double dc, double da) {
   return std::max({d.cwiseAbs().maxCoeff() / m.rapid_feed_mm_per_min * 60.0, rotaryIndexSeconds(dc, m.c),
-                   rotaryIndexSeconds(db, m.b)});
+                   rotaryIndexSeconds(db, m.b), rotaryIndexSeconds(da, m.a)});
 }
 
 double linearFeedSeconds(double path_mm, double F) { return path_mm / F * 60.0; }

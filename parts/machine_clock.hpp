@@ -5,7 +5,7 @@
 // end.
 //
 // Contract (seconds; mm, deg, mm/min, deg/min):
-// - rapidSeconds: every axis at once, the linear ones at the machine's rapid feed, B and C at
+// - rapidSeconds: every axis at once, the linear ones at the machine's rapid feed, A, B and C at
 //   their max_speed; the slowest axis's time.
 // - rotaryIndexSeconds: a rotary axis indexing by delta at its positioning speed; 0 for no
 //   move; an InputError for a move of an axis the machine does not have (or has no speed for).
@@ -18,7 +18,8 @@
 
 namespace probeloop::parts {
 
-double rapidSeconds(const Machine& m, const Eigen::Vector3d& gauge_delta_mm, double b_delta_deg = 0, double c_delta_deg = 0);
+double rapidSeconds(const Machine& m, const Eigen::Vector3d& gauge_delta_mm, double b_delta_deg = 0, double c_delta_deg = 0,
+                    double a_delta_deg = 0);
 double rotaryIndexSeconds(double delta_deg, const RotaryAxis& axis);
 double linearFeedSeconds(double path_mm, double feed_mm_per_min);
 double rotaryFeedSeconds(double delta_deg, double feed_deg_per_min);

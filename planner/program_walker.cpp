@@ -29,6 +29,7 @@ NotedProgram newNotedProgram(const parts::Machine& m, const std::string& role, c
   p.program.title = title;
   p.program.number = number;
   p.program.work_offset = m.work_offset;
+  p.program.has_a_axis = m.a.present;
   p.program.has_b_axis = m.b.present;
   p.program.has_c_axis = m.c.present;
   return p;
@@ -192,6 +193,15 @@ void ProgramWalker::step(const gcode::Op& op, const OpNote& note) {
             times_.rotary_index_s += dt;
             t_ += dt;
             b_ = r.b_deg;
+          },
+          [&](const gcode::RotateA& r) {
+            if (!m_.a.present) fail(note, "A move on a machine without an A axis (" + m_.file + ")");
+            if (!m_.a.continuous && !(r.a_deg >= m_.a.min_deg - 1e-9 && r.a_deg <= m_.a.max_deg + 1e-9))
+              fail(note, "A = " + formatNumber(r.a_deg, 3) + " deg is outside the A travel of " + m_.file);
+            const double dt = rotaryIndexSeconds(r.a_deg - a_, m_.a);
+            times_.rotary_index_s += dt;
+            t_ += dt;
+            a_ = r.a_deg;
           },
           [&](const gcode::ToolChange& tc) {
             if (spindle_rpm_ != 0) fail(note, "tool change T" + std::to_string(tc.tool) + " with the spindle turning (M5 first)");

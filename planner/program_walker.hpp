@@ -4,19 +4,19 @@
 //
 // Clock (exactly docs/simulator.md §2 "Clock", no acceleration; the functions below are the
 // one copy of it in the planner, the walker's and its tests'): rapids move every axis at the
-// rapid feed (B and C at their maximum positioning speed) and take the slowest axis's time;
+// rapid feed (A, B and C at their maximum positioning speed) and take the slowest axis's time;
 // feeds take XYZ path length / F, a move of C alone (TurnC) degrees / F; protected moves run
 // to their end; measuring moves are timed to the nominal contact the planner names; dwells;
 // tool changes at tool_change.time. Several programs run back to back in one session:
 // position, C, tool and clock carry over. The machine starts with the gauge line at the top of
-// the Z travel above the C axis (clamped into the X/Y travel), C = B = 0, empty spindle. C is
+// the Z travel above the C axis (clamped into the X/Y travel), C = B = A = 0, empty spindle. C is
 // a linear axis here, as in the simulator: after TurnC +360 it reads 360, and an absolute
 // index from there turns the long way (a control with C rollover may go another way round:
 // only the time differs, docs/thermal-test-piece.md §5).
 //
 // Checks (SafetyError "<program>: <where>: <what> ..." naming the axis and value): every
 // number finite; every target of the gauge line (tip + tool length) within the X/Y/Z travel,
-// B and C within theirs (a non-continuous C also for TurnC); linear feeds within the slowest
+// A, B and C within theirs (a non-continuous C also for TurnC); linear feeds within the slowest
 // axis's max_feed (as the simulator checks them); a move of C alone within C's
 // max_turning_speed; a cut only with a cutter and the spindle turning; probing only with the
 // probe and the spindle stopped; a tool change only with the spindle stopped and the gauge
@@ -123,7 +123,7 @@ class ProgramWalker {
   std::function<void(const Motion&)> check_;
   const std::string* program_ = nullptr;
   Eigen::Vector3d gauge_;
-  double c_ = 0, b_ = 0, t_ = 0, spindle_rpm_ = 0;
+  double c_ = 0, b_ = 0, a_ = 0, t_ = 0, spindle_rpm_ = 0;
   WalkerTool tool_;  // number 0 = empty spindle until the first change
   WalkTimes times_;
 };

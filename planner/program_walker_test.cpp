@@ -113,3 +113,21 @@ TEST(ProgramWalker, NumbersThatAreNotFiniteNeverPass) {
   p.notes.push_back(n);
   EXPECT_NE(failure(mill(), p).find("p.ngc: here: a coordinate, feed or time that is not a finite number"), std::string::npos);
 }
+
+// The A axis of a table-table A/C machine (issue 33): indexed at its positioning speed, within
+// its travel, refused on a machine without one.
+TEST(ProgramWalker, TheAAxisIsTimedAndCheckedLikeB) {
+  const auto ac = parts::loadMachine(src + "/parts/machines/table_table_ac.yaml");  // A 20 rpm, travel +-120 deg
+  const auto p = program({gcode::RotateA{-30}, gcode::RotateA{60}});
+  ProgramWalker w(ac, {cutter()});
+  w.run(p);
+  // 30 + 90 deg at 20 rpm = 7200 deg/min: 1 s in all.
+  EXPECT_NEAR(w.times().rotary_index_s, 120.0 / 7200.0 * 60.0, 1e-12);
+  EXPECT_DOUBLE_EQ(rapidSeconds(ac, Vector3d(0, 0, 0), 0, 0, 90), 0.75);
+  EXPECT_NE(failure(ac, program({gcode::RotateA{130}})).find("p.ngc: op 1: A = 130.000 deg is outside the A travel"),
+            std::string::npos);
+  EXPECT_NE(failure(mill(), program({gcode::RotateA{10}})).find("p.ngc: op 1: A move on a machine without an A axis"),
+            std::string::npos);
+  EXPECT_TRUE(newNotedProgram(ac, "r", "f.ngc", 1, "t").program.has_a_axis);
+  EXPECT_FALSE(newNotedProgram(mill(), "r", "f.ngc", 1, "t").program.has_a_axis);
+}

@@ -64,7 +64,8 @@ void VirtualMachine::traceRow(const char* kind, const MachinePosition& to, doubl
   if (!trace_on_) return;
   trace_ << formatNumber(t_start, 3) << "," << formatNumber(t_ - t_start, 3) << "," << line_ << "," << kind << ","
          << formatNumber(to.xyz_mm.x(), 6) << "," << formatNumber(to.xyz_mm.y(), 6) << ","
-         << formatNumber(to.xyz_mm.z(), 6) << "," << formatNumber(to.b_deg, 6) << "," << formatNumber(to.c_deg, 6)
+         << formatNumber(to.xyz_mm.z(), 6) << "," << (m_.a.present ? formatNumber(to.a_deg, 6) + "," : "")
+         << formatNumber(to.b_deg, 6) << "," << formatNumber(to.c_deg, 6)
          << "," << formatNumber(feed, 3) << "," << tool_;
   if (trace_program_) trace_ << "," << std::filesystem::path(program_file_).filename().string();
   trace_ << "\n";

@@ -255,8 +255,8 @@ void VirtualMachine::recordCutState(const Vector3d& deflection_mm, const Vector3
 void VirtualMachine::cutMove(const MachinePosition& to, double F) {
   const parts::CuttingTool& t = *cutter();
   const double r = t.diameter_mm / 2;
-  if (to.b_deg != pos_.b_deg || (to.c_deg != pos_.c_deg && to.xyz_mm != pos_.xyz_mm))
-    throw InputError("", 0, "cutting with a rotary axis moving together with X/Y/Z (or B) is not modelled");
+  if (to.b_deg != pos_.b_deg || to.a_deg != pos_.a_deg || (to.c_deg != pos_.c_deg && to.xyz_mm != pos_.xyz_mm))
+    throw InputError("", 0, "cutting with a rotary axis moving together with X/Y/Z (or A, B) is not modelled");
   if (to.c_deg != pos_.c_deg) return arcCut(to, F);
   const double len_cut = (to.xyz_mm - pos_.xyz_mm).norm();
   noteAxesMotion(to.xyz_mm, len_cut / F * 60.0);

@@ -29,8 +29,10 @@ void VirtualMachine::refreshOffsets() {
 void VirtualMachine::rapid(const MachinePosition& to) {
   refreshOffsets();
   checkTravel(to);
+  checkAxisA(to);
   checkPath(to, "rapid (G0)");
-  const double t = parts::rapidSeconds(m_, to.xyz_mm - pos_.xyz_mm, to.b_deg - pos_.b_deg, to.c_deg - pos_.c_deg);
+  const double t = parts::rapidSeconds(m_, to.xyz_mm - pos_.xyz_mm, to.b_deg - pos_.b_deg, to.c_deg - pos_.c_deg,
+                                       to.a_deg - pos_.a_deg);
   const double t0 = t_;
   noteAxesMotion(to.xyz_mm, t);
   move(t, t > 0 ? (to.xyz_mm - pos_.xyz_mm).norm() / t * 60.0 : 0.0);
@@ -43,7 +45,9 @@ void VirtualMachine::feed(const MachinePosition& to, double F) {
   checkTravel(to);
   // A move of rotary axes alone reads F in deg/min (LinuxCNC and Fanuc): the axis turns at
   // F / 360 rpm, limited by its turning speed, not by the XYZ feed.
-  const bool rotary_only = to.xyz_mm == pos_.xyz_mm && (to.c_deg != pos_.c_deg || to.b_deg != pos_.b_deg);
+  const bool rotary_only =
+      to.xyz_mm == pos_.xyz_mm && (to.c_deg != pos_.c_deg || to.b_deg != pos_.b_deg || to.a_deg != pos_.a_deg);
+  checkAxisA(to, rotary_only ? F : 0.0);
   if (rotary_only) checkRotaryFeed(to, F);
   else checkFeed(F);
   if (w_ && isCutter() && spindle_rpm_ != 0) {
@@ -52,7 +56,8 @@ void VirtualMachine::feed(const MachinePosition& to, double F) {
   }
   checkPath(to, spindle_rpm_ == 0 && isCutter() ? "feed move (G1/G2/G3) with the spindle stopped" : "feed move (G1/G2/G3)");
   const double len = (to.xyz_mm - pos_.xyz_mm).norm();
-  const double rot = std::max(std::fabs(to.c_deg - pos_.c_deg), std::fabs(to.b_deg - pos_.b_deg));
+  const double rot = std::max({std::fabs(to.c_deg - pos_.c_deg), std::fabs(to.b_deg - pos_.b_deg),
+                               std::fabs(to.a_deg - pos_.a_deg)});
   const double t0 = t_;
   const double dt = len > 0 ? parts::linearFeedSeconds(len, F) : parts::rotaryFeedSeconds(rot, F);
   c_move_rpm_ = cMoveRpm(to, dt);
@@ -61,6 +66,24 @@ void VirtualMachine::feed(const MachinePosition& to, double F) {
   c_move_rpm_ = 0;
   traceRow("feed", to, F, t0);
   pos_ = to;
+}
+
+// The A axis (a cradle about X): its travel, and its turning speed in a move of the rotary axes
+// alone at F deg/min (rotary_feed > 0). machine_kinematics.cpp's checkTravel and
+// checkRotaryFeed cover X, Y, Z, B and C.
+void VirtualMachine::checkAxisA(const MachinePosition& to, double rotary_feed_deg_per_min) const {
+  if (!std::isfinite(to.a_deg)) throw SafetyError("a rotary target that is not a number");
+  if (to.a_deg != pos_.a_deg && !m_.a.present) throw SafetyError("move of A on a machine without an A axis");
+  if (!m_.a.present) return;
+  if (!m_.a.continuous && !(to.a_deg >= m_.a.min_deg - 1e-9 && to.a_deg <= m_.a.max_deg + 1e-9))
+    throw SafetyError("move outside travel: A " + formatNumber(to.a_deg) + " deg");
+  if (rotary_feed_deg_per_min > 0 && to.a_deg != pos_.a_deg) {
+    const double rpm = rotary_feed_deg_per_min / 360.0;
+    const double limit = m_.a.max_turning_speed_rpm > 0 ? m_.a.max_turning_speed_rpm : m_.a.max_speed_rpm;
+    if (rpm > limit + 1e-9)
+      throw SafetyError("rotary feed F" + formatNumber(rotary_feed_deg_per_min) + " deg/min (" + formatNumber(rpm) +
+                        " rpm) exceeds the A axis's maximum turning speed " + formatNumber(limit) + " rpm");
+  }
 }
 
 // The C axis's real speed during a feed move that turns it (a heat input, and the inputs

@@ -18,8 +18,9 @@ namespace probeloop::sim::detail {
 // the workpiece in probeWorkpiece.
 gcode::ProbeOutcome VirtualMachine::probeMove(const MachinePosition& to, double F, gcode::ProbeMode mode) {
   checkTravel(to);
+  checkAxisA(to);
   checkFeed(F);
-  if (to.c_deg != pos_.c_deg || to.b_deg != pos_.b_deg)
+  if (to.c_deg != pos_.c_deg || to.b_deg != pos_.b_deg || to.a_deg != pos_.a_deg)
     throw InputError("", 0, "a probe move with a rotary axis is not modelled");
   const Vector3d g0 = pos_.xyz_mm, g1 = to.xyz_mm;
   const double len = (g1 - g0).norm();

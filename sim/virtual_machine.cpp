@@ -118,7 +118,8 @@ void VirtualMachine::finish() {
 void VirtualMachine::enableTrace(bool with_program) {
   trace_on_ = true;
   trace_program_ = with_program;
-  trace_ << "time_s,duration_s,line,kind,x_mm,y_mm,z_mm,b_deg,c_deg,feed_mm_per_min,tool"
+  // A machine with an A axis (a table-table A/C) also traces A, before B.
+  trace_ << "time_s,duration_s,line,kind,x_mm,y_mm,z_mm," << (m_.a.present ? "a_deg," : "") << "b_deg,c_deg,feed_mm_per_min,tool"
          << (with_program ? ",program" : "") << "\n";
 }
 

@@ -187,6 +187,7 @@ class VirtualMachine : public gcode::MachineInterface {
   void checkFeed(double F) const;
   void checkRotaryFeed(const MachinePosition& to, double F_deg_per_min) const;
   void checkTravel(const MachinePosition& to) const;
+  void checkAxisA(const MachinePosition& to, double rotary_feed_deg_per_min = 0) const;  // machine_motion.cpp
 
   // --- the workpiece (machine_cutting.cpp) ------------------------------------------------
   Vector3d toWorkpiece(const Vector3d& q) const;

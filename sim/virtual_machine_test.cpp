@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 #include <atomic>
 #include <functional>
 #include <map>
@@ -257,6 +259,36 @@ TEST(VirtualMachine, UnsafeMovesAreRefusedWithTheProgramLine) {
   expectSafetyError([&] { runText(head + "G0 X0 Y0 Z120\nG1 Z1 F500\n"); }, "t.ngc:5: feed move (G1/G2/G3) would hit the table");
   expectSafetyError([&] { runText(head + "G0 X-160 Y20 Z80\nG0 C90\n"); }, "t.ngc:5: rapid (G0) turns the table");
   expectSafetyError([&] { runText(head + "S1000 M3\n"); }, "t.ngc:4: spindle start (M3/M4) with the touch probe");
+}
+
+// The A axis (issue 33): refused on the NMV 5000 (B/C), checked against the travel of the
+// table-table A/C machine, and indexed there at its positioning speed.
+TEST(VirtualMachine, TheAAxisIsCheckedAndTimed) {
+  const std::string head = "G21 G90\nT99 M6\nG43 H99\n";
+  expectSafetyError([&] { runText(head + "G0 A10\n"); }, "t.ngc:4: move of A on a machine without an A axis");
+  auto artifact = parts::loadSphereArtifact(src("parts/sphere_artifact.yaml"));
+  const auto ac = parts::loadMachine(src("parts/machines/table_table_ac.yaml"));  // A +-120 deg at 20 rpm
+  expectSafetyError([&] { simulateProgram("t.ngc", head + "G0 A130\n", ac, artifact, truthFrom(""), 1); },
+                    "t.ngc:4: move outside travel: A 130 deg");
+  expectSafetyError([&] { simulateProgram("t.ngc", head + "G1 A30 F36000\n", ac, artifact, truthFrom(""), 1); },
+                    "exceeds the A axis's maximum turning speed 20 rpm");
+  SimulationPart part;
+  part.artifact = &artifact;
+  part.trace = true;
+  const auto out = simulateProgram("t.ngc", head + "G0 A-90\nM2\n", ac, part, truthFrom(""), 1);
+  // The trace carries A before B; 90 deg at 20 rpm = 7200 deg/min take 0.75 s.
+  EXPECT_EQ(out.trace_csv.rfind("time_s,duration_s,line,kind,x_mm,y_mm,z_mm,a_deg,b_deg,c_deg,", 0), 0u) << out.trace_csv;
+  const auto row = out.trace_csv.find(",4,rapid,");
+  ASSERT_NE(row, std::string::npos) << out.trace_csv;
+  const auto start = out.trace_csv.rfind('\n', row) + 1;
+  const std::string line = out.trace_csv.substr(start, out.trace_csv.find('\n', row) - start);
+  std::vector<std::string> f;
+  std::stringstream ss(line);
+  for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
+  ASSERT_GE(f.size(), 10u) << line;
+  EXPECT_NEAR(std::stod(f[1]), 0.75, 1e-9) << line;
+  EXPECT_EQ(std::stod(f[7]), -90) << line;
+  EXPECT_EQ(std::stod(f[8]), 0) << line;
 }
 
 }  // namespace

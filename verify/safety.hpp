@@ -13,7 +13,7 @@
 //   (a word it does not model, an unknown tool) is an InputError naming file:line, never a
 //   finding.
 // - Rules (names as they appear in reports):
-//   travel                 the gauge line outside X/Y/Z travel, B/C outside a limited rotary travel;
+//   travel                 the gauge line outside X/Y/Z travel, A/B/C outside a limited rotary travel;
 //   collision              a rapid or feed move (and a probe move before its tip touches) in which
 //                          the tool (cutter, shank, holder) or the probe (tip ball, stylus shaft,
 //                          body) meets the artifact (sphere, stem), the stock or what remains of
@@ -27,17 +27,24 @@
 //                          past the contact;
 //   positioning-unprotected a rapid or feed move with the probe in the spindle that, below the
 //                          clearance plane, brings the probe closer to the part (not a retreat);
-//   rotary-below-clearance a B or C move while the tool or probe is below the clearance plane and
-//                          inside the envelope the turning part sweeps (a cut by a feed move of C
-//                          with the spindle on is a cut, not a positioning move);
+//   rotary-below-clearance a C move on the level table while the tool or probe is below the
+//                          clearance plane and inside the envelope the turning part sweeps (a cut
+//                          by a feed move of C with the spindle on is a cut, not a positioning
+//                          move); an A or B move below the plane when the machine does not
+//                          locate the tilting axis's line;
+//   tilt-swing             an A or B move (or a C move on the tilted table) during which what the
+//                          table carries, or the table (a disc), comes within 2 mm of the tool or
+//                          probe, or the probe is below the tilted table plane, at some angle
+//                          between the start and the end (issue 33);
 //   spindle-with-probe     M3/M4 with the probe in the spindle;
 //   program-stops          the program itself stops (alarm, ABORT, G38.2 without contact) on the
 //                          nominal part: a protected move that touches, a probing move that
 //                          meets nothing.
-// - Geometry: every tool is vertical (B = 0; B moves are checked for travel and clearance
-//   only) and rotationally symmetric: vertical cylinders and the stylus ball. Material is a
-//   height field of `cell_mm` cells in the table frame; a tool within `tolerance_mm` of
-//   material counts as clear.
+// - Geometry: every tool is vertical and rotationally symmetric: vertical cylinders and the
+//   stylus ball. Material is a height field of `cell_mm` cells in the table frame; a tool
+//   within `tolerance_mm` of material counts as clear. With the table tilted (a machine that
+//   locates its A or B axis line) every body is placed by the pose, the stock as its bounding
+//   cylinder, the table as a disc (docs/reliability.md#geometry-modelled).
 #pragma once
 #include <Eigen/Dense>
 #include <string>
