@@ -2,6 +2,7 @@
 // is the notes' written-out first-order model (§2.5, derived with sympy in
 // notes/verify/derive002.py), typed in below from the notes, not from lathe_chain.cpp; the
 // ideal tool offset is eq. 24 with its -z (notes §2.4), typed in as well.
+#include "geometry/identifiability.hpp"
 #include "geometry/lathe_chain.hpp"
 
 #include <gtest/gtest.h>
@@ -214,6 +215,50 @@ TEST(LatheChain, TwentyFourParametersAreTheBodiesTwists) {
   ChainState s;
   p[4].addTo(s, 4, 10.0);  // 10 urad
   EXPECT_DOUBLE_EQ(s.motion[static_cast<std::size_t>(latheChainIndex(1))].rotation_rad.y(), 1e-5);
+}
+
+
+// What turned parts tell of the 24 errors. With one tool, the notes' Px and Pz at centre
+// height (Wy = 0, x and z following W) reduce to: Px = [a constant combination] - ey4 Wz,
+// Pz = [a constant combination] + (ey4 - ey1) Wx, since every other lever (c4 + Wz - z -
+// c1 = c2 + c3 + Tz, a4 + Wx - a1 - a2 - x = a3 + Tx, ...) is fixed by the tool. Diameters
+// and faces anywhere on the part therefore identify 4 combinations: the two constants, ey4
+// (Px's slope along Wz) and ey1 (Pz's slope along Wx, given ey4); the translations along X
+// of the four bodies only as their sum dx1 + dx2 + dx3 - dx4.
+TEST(LatheChain, TurnedDiametersAndFacesIdentifyFourCombinationsOfTheTwentyFour) {
+  const LatheOffsets off = latheDefaultOffsets();
+  const Vector3d T(-150, 0, -100);
+  const KinematicChain chain = latheChain(off, T);
+  auto observe = [&](const ChainState& s) {
+    Eigen::VectorXd v(18);
+    int k = 0;
+    for (double wx : {15.0, 25.0, 40.0})
+      for (double wz : {20.0, 80.0, 140.0}) {
+        const Vector3d W(wx, 0, wz);
+        const Eigen::Vector2d xz = latheNominalXZ(off, T, W);
+        ChainState at = s;
+        at.positions = {{"X", xz.x()}, {"Z", xz.y()}};
+        const Vector3d cut = workpieceFrame(chain, at).inverse() * toolTip(chain, at);
+        v(k++) = 2 * (std::hypot(cut.x(), cut.y()) - wx);
+        v(k++) = cut.z() - wz;
+      }
+    return v;
+  };
+  const auto params = latheParameters();
+  std::vector<std::string> names;
+  for (const auto& p : params) names.push_back(p.name);
+  const Eigen::MatrixXd J = chainSensitivity(observe, ChainState{}, params, chain.bodyCount());
+  const Identifiability id = identifiability(J, names, 1e-9);
+  EXPECT_EQ(id.rank, 4);
+  // the slopes give ey4 (Px along Wz) and then ey1 (Pz along Wx); nothing else alone
+  for (int i = 0; i < 24; ++i)
+    EXPECT_EQ(id.identifiable[static_cast<std::size_t>(i)], names[static_cast<std::size_t>(i)] == "ey1" || names[static_cast<std::size_t>(i)] == "ey4")
+        << names[static_cast<std::size_t>(i)];
+  // dx1 + dx2 + dx3 - dx4: moving dx1 up and dx2 down by as much changes nothing
+  ChainState s;
+  params[0].addTo(s, 4, 5.0);
+  params[6].addTo(s, 4, -5.0);
+  EXPECT_LT(observe(s).cwiseAbs().maxCoeff(), 1e-12);
 }
 
 }  // namespace
