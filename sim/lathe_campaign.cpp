@@ -104,10 +104,13 @@ LatheTruth loadLatheTruth(const std::string& path) {
     g->finish();
   }
   if (auto c = root.mapIfPresent("campaign")) {
-    t.duration_s = c->positiveQuantity("duration", Dimension::Duration);
-    t.cycle_s = c->positiveQuantity("cycle", Dimension::Duration);
-    t.inputs_rate_s = c->positiveQuantity("inputs_rate", Dimension::Duration);
+    t.duration_s = c->quantityOr("duration", Dimension::Duration, t.duration_s);
+    t.cycle_s = c->quantityOr("cycle", Dimension::Duration, t.cycle_s);
+    t.inputs_rate_s = c->quantityOr("inputs_rate", Dimension::Duration, t.inputs_rate_s);
     t.cold_start_s = c->quantityOr("cold_start", Dimension::Duration, t.cold_start_s);
+    for (const char* k : {"duration", "cycle", "inputs_rate"})
+      if (c->has(k) && c->quantity(k, Dimension::Duration) <= 0) c->fail(k, "must be positive");
+    if (t.cold_start_s < 0) c->fail("cold_start", "a duration >= 0");
     const double r = t.cycle_s / t.inputs_rate_s;
     if (std::abs(r - std::round(r)) > 1e-9)
       c->fail("cycle", "a whole number of inputs_rate steps (parts are measured on the inputs' clock)");
@@ -115,10 +118,10 @@ LatheTruth loadLatheTruth(const std::string& path) {
     c->finish();
   }
   if (auto m = root.mapIfPresent("measurement")) {
-    t.diameter_noise_um = m->quantity("diameter_noise", Dimension::Micrometre);
-    t.face_noise_um = m->quantity("face_noise", Dimension::Micrometre);
-    if (t.diameter_noise_um <= 0 || t.face_noise_um <= 0)
-      m->fail("diameter_noise", "a measurement has noise: > 0 (the errors' U comes from it)");
+    t.diameter_noise_um = m->quantityOr("diameter_noise", Dimension::Micrometre, t.diameter_noise_um);
+    t.face_noise_um = m->quantityOr("face_noise", Dimension::Micrometre, t.face_noise_um);
+    if (t.diameter_noise_um <= 0) m->fail("diameter_noise", "a measurement has noise: > 0 (the errors' U comes from it)");
+    if (t.face_noise_um <= 0) m->fail("face_noise", "a measurement has noise: > 0 (the errors' U comes from it)");
     m->finish();
   }
   for (auto& s : root.mapList("sources")) t.sources.push_back(readSource(s));

@@ -116,6 +116,8 @@ TEST(LatheCampaign, LoaderRefusesWhatCannotBeSimulated) {
           "tau: 60 min, per_K: {dz: 2 um}, screw_um_per_m_K: 11.5}\n",
           "linear axis");
   refuses(std::string("measurment: {diameter_noise: 1 um}\n") + kSource, "measurment");
+  refuses(std::string("measurement: {face_noise: 0 um}\n") + kSource, "face_noise");
+  refuses(std::string("campaign: {cycle: 0 min}\n") + kSource, "cycle");
   refuses("sources:\n  - {input: spindle_rpm, body: chuck, levels: [0], hold: 1 h, K_per_unit: 1, tau: 1 h, per_K: {}}\n",
           "body");
 }
