@@ -89,6 +89,12 @@ class Walker {
     t_->c_index_s += parts::rotaryIndexSeconds(r.b_deg - b_, m_.b);
     b_ = r.b_deg;
   }
+  void step(const gcode::RotateA& r, const std::string& where) {
+    if (!m_.a.continuous && (r.a_deg < m_.a.min_deg || r.a_deg > m_.a.max_deg))
+      throw SafetyError(where + ": A = " + formatNumber(r.a_deg, 3) + " deg is outside the A travel");
+    t_->c_index_s += parts::rotaryIndexSeconds(r.a_deg - a_, m_.a);
+    a_ = r.a_deg;
+  }
   void step(const gcode::ToolChange& tc, const std::string&) {
     t_->tool_change_s += m_.tool_change.time_s;
     length_ = tc.apply_length_offset ? m_.probe.length_mm : 0.0;
@@ -117,7 +123,7 @@ class Walker {
   CycleTime* t_;
   Vector3d gauge_;
   double length_ = 0.0;
-  double c_ = 0.0, b_ = 0.0;
+  double c_ = 0.0, b_ = 0.0, a_ = 0.0;
   Vector3d contact_ = Vector3d::Zero();
 };
 
@@ -221,6 +227,7 @@ SpherePlan planSphereCycle(const SphereArtifact& a, const Machine& m, const Plan
   prog.title = "probeloop sphere-artifact cycle [seed 004 Ch. 5] - generated, do not edit";
   prog.work_offset = m.work_offset;
   prog.has_b_axis = m.b.present;
+  prog.has_a_axis = m.a.present;
   prog.log_file = files.log_file;
   prog.gap_s = a.gap_s;
   prog.live_interval = a.live_interval;
@@ -240,6 +247,8 @@ SpherePlan planSphereCycle(const SphereArtifact& a, const Machine& m, const Plan
   emit(tc_in, gcode::RapidMachineZ{tc_z}, "probe in");
   emit(tc_in, gcode::ToolChange{m.probe.tool, true}, "probe in");
 
+  const bool tilt_a = man.tilt_axis && man.tilt_axis->name == "A";
+  auto tiltOp = [&](double deg) -> gcode::Op { return tilt_a ? gcode::Op(gcode::RotateA{deg}) : gcode::Op(gcode::RotateB{deg}); };
   double tilt_now = 0;
   for (const auto& s : man.spheres) {
     const std::string tilt = man.tilt_axis ? man.tilt_axis->name : "";
@@ -253,7 +262,7 @@ SpherePlan planSphereCycle(const SphereArtifact& a, const Machine& m, const Plan
       // above what it carries (on a tilted table C lifts the sphere as it turns); then the tip
       // comes down above this position's sphere.
       emit(body, gcode::RapidMachineZ{tc_z}, pos + ": up before the " + tilt + " and C axes move");
-      if (s.tilt_deg != tilt_now) emit(body, gcode::RotateB{s.tilt_deg}, pos);
+      if (s.tilt_deg != tilt_now) emit(body, tiltOp(s.tilt_deg), pos);
       emit(body, gcode::RotateC{s.c_deg}, pos);
       emit(body, gcode::Rapid{s.nominal_centre_mm.x(), s.nominal_centre_mm.y(), std::nullopt}, pos + ": above the sphere");
       emit(body, gcode::Rapid{std::nullopt, std::nullopt, z_clear_here}, pos + ": clearance plane");
@@ -286,7 +295,7 @@ SpherePlan planSphereCycle(const SphereArtifact& a, const Machine& m, const Plan
   }
   if (tilt_now != 0) {
     emit(body, gcode::RapidMachineZ{tc_z}, "level the table: up before the swing");
-    emit(body, gcode::RotateB{0}, "level the table");
+    emit(body, tiltOp(0), "level the table");
   }
   auto& tc_out = a.tool_change_each_cycle ? body : after;
   emit(tc_out, gcode::RapidMachineZ{tc_z}, "probe out");

@@ -103,19 +103,23 @@ std::array<double, 6> VirtualMachine::tiltLocationErrors() const {
 
 Eigen::Isometry3d VirtualMachine::tiltTransform() const {
   const auto e = tiltLocationErrors();
-  const double q = pos_.b_deg;
+  const bool on_a = m_.a.present;
+  const double q = on_a ? pos_.a_deg : pos_.b_deg;
   const bool errors = std::any_of(e.begin(), e.end(), [](double v) { return v != 0; });
   if (q == 0 && !errors) return Eigen::Isometry3d::Identity();
-  if (!m_.b_axis_centre_xz_mm)
-    throw SafetyError("the table is tilted (B " + formatNumber(q) + " deg) but " + m_.file +
-                      " does not say where the B axis lies (b_axis: centre_x, centre_z)");
-  // The B line of the machine with its location errors, as the evaluation's chain has it
+  const auto& centre = on_a ? m_.a_axis_centre_yz_mm : m_.b_axis_centre_xz_mm;
+  if (!centre)
+    throw SafetyError(std::string("the table is tilted (") + (on_a ? "A " : "B ") + formatNumber(q) + " deg) but " + m_.file +
+                      " does not say where the " + (on_a ? "A axis lies (a_axis: centre_y" : "B axis lies (b_axis: centre_x") +
+                      ", centre_z)");
+  // The tilting axis's line with its location errors, as the evaluation's chain has it
   // (ISO 230-7: the table turns about the displaced and tilted line; parts/machine_chain.hpp).
   geometry::Joint j;
   j.kind = geometry::JointKind::Rotary;
-  j.axis = "B";
-  j.direction = Vector3d::UnitY() * (m_.b.positive_is_clockwise ? -1.0 : 1.0);
-  j.point_mm = Vector3d(m_.b_axis_centre_xz_mm->x(), 0, m_.b_axis_centre_xz_mm->y());
+  j.axis = on_a ? "A" : "B";
+  const parts::RotaryAxis& ax = on_a ? m_.a : m_.b;
+  j.direction = (on_a ? Vector3d::UnitX() : Vector3d::UnitY()) * (ax.positive_is_clockwise ? -1.0 : 1.0);
+  j.point_mm = on_a ? Vector3d(0, centre->x(), centre->y()) : Vector3d(centre->x(), 0, centre->y());
   geometry::Twist t;
   t.translation_mm = Vector3d(e[0], e[1], e[2]) * 1e-3;
   t.rotation_rad = Vector3d(e[3], e[4], e[5]) * 1e-6;
