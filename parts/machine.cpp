@@ -49,6 +49,11 @@ RotaryAxis readRotary(YamlMap m, bool with_sense) {
   if (with_sense) {
     a.positive_is_clockwise =
         m.choice("positive_rotation", {"clockwise", "counterclockwise"}) == "clockwise";
+  } else if (m.has("positive_rotation")) {
+    // A tilting axis: clockwise (seen from +X for A, +Y for B) unless stated, as on a
+    // workpiece-side primed axis (ISO 841).
+    a.positive_is_clockwise =
+        m.choice("positive_rotation", {"clockwise", "counterclockwise"}) == "clockwise";
   }
   m.finish();
   return a;
@@ -128,7 +133,9 @@ Machine loadMachine(const std::string& path) {
   mc.x = readLinear(axes.map("X"));
   mc.y = readLinear(axes.map("Y"));
   mc.z = readLinear(axes.map("Z"));
+  if (auto a = axes.mapIfPresent("A")) mc.a = readRotary(*a, false);
   if (auto b = axes.mapIfPresent("B")) mc.b = readRotary(*b, false);
+  if (mc.a.present && mc.b.present) axes.fail("A", "a machine with both A and B is not supported (one tilting axis carries the C table)");
   if (auto c = axes.mapIfPresent("C")) mc.c = readRotary(*c, true);
   axes.finish();
   mc.rapid_feed_mm_per_min = root.quantity("rapid_feed", Dimension::Feed);
@@ -145,6 +152,18 @@ Machine loadMachine(const std::string& path) {
     YamlMap table = root.map("table");
     mc.table_surface_z_mm = table.quantity("surface_z", Dimension::Length);
     table.finish();
+  }
+  if (auto ba = root.mapIfPresent("b_axis")) {
+    if (!mc.b.present) ba->fail("centre_x", "b_axis needs a B axis under axes");
+    mc.b_axis_centre_xz_mm = Eigen::Vector2d(ba->quantity("centre_x", Dimension::Length),
+                                             ba->quantity("centre_z", Dimension::Length));
+    ba->finish();
+  }
+  if (auto aa = root.mapIfPresent("a_axis")) {
+    if (!mc.a.present) aa->fail("centre_y", "a_axis needs an A axis under axes");
+    mc.a_axis_centre_yz_mm = Eigen::Vector2d(aa->quantity("centre_y", Dimension::Length),
+                                             aa->quantity("centre_z", Dimension::Length));
+    aa->finish();
   }
   try {
     mc.workpiece_side = workpieceSideAxes(mc.iso10791_code);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <Eigen/Dense>
 #include <array>
+#include <optional>
 #include <string>
 
 namespace probeloop::parts {
@@ -29,7 +30,7 @@ struct RotaryAxis {
   // L2024: C at 1200 rpm); default max_speed.
   double max_turning_speed_rpm = 0;
   double resolution_deg = 0.001;
-  // Sense in which the table turns for +C, seen from +Z. A workpiece-side C' axis turns the
+  // Sense in which the table turns for +C, seen from +Z (for A and B: seen from +X, +Y). A workpiece-side C' axis turns the
   // table clockwise for +C (ISO 841: the workpiece moves opposite to the tool's +C).
   bool positive_is_clockwise = true;
 };
@@ -64,9 +65,13 @@ struct Machine {
   std::string iso10791_code;
   Dialect dialect = Dialect::LinuxCnc;
   LinearAxis x, y, z;
-  RotaryAxis b, c;
+  RotaryAxis a, b, c;  // A tilts about X, B about Y (a trunnion carrying C), C turns the table
   double rapid_feed_mm_per_min = 0;     // non-probing moves (the thesis: 6000 mm/min)
   Eigen::Vector2d c_axis_centre_mm = Eigen::Vector2d::Zero();  // X, Y of C in machine coords
+  // Where the tilting axis lies (machine coordinates, tip coordinates with the probe's length
+  // offset, at A = B = C = 0): B's axis line through (x, z) parallel to Y, A's through (y, z)
+  // parallel to X. Optional: only the cycles that tilt the table need them (issue 33).
+  std::optional<Eigen::Vector2d> b_axis_centre_xz_mm, a_axis_centre_yz_mm;
   double table_surface_z_mm = 0;        // machine Z (tip coordinates) of the table surface
   int work_offset = 6;                  // 1..6 = G54..G59; the program zeroes it
   ToolChangeSpec tool_change;
