@@ -208,6 +208,22 @@ structure:
                InputError);
 }
 
+// examples/truth_gantry_seed003.yaml is seed003Gantry() in the machine's frame (Y and Z of the
+// thesis swapped): for any force the tip moves as in the thesis's frame, relabelled (the swap
+// is a reflection; eps = l x F and eps x arm each flip, so the displacement does not).
+TEST(Machining, TheGantryTruthIsTheThesisGantry) {
+  const auto truth = loadMachineTruth(src("examples/truth_gantry_seed003.yaml"));
+  ASSERT_EQ(truth.structure_units.size(), 2u);
+  const auto thesis = probeloop::model::seed003Gantry();
+  for (const Vector3d F_t : {Vector3d(100, 0, 0), Vector3d(0, 100, 0), Vector3d(0, 0, 100), Vector3d(100, 100, 100), Vector3d(-30, 70, 10)}) {
+    const Vector3d d_t = probeloop::model::tcpDisplacement_mm(thesis, F_t);
+    const Vector3d d_m = probeloop::model::tcpDisplacement_mm(truth.structure_units, Vector3d(F_t.x(), F_t.z(), F_t.y()));
+    EXPECT_NEAR(d_m.x(), d_t.x(), 1e-15) << F_t.transpose();
+    EXPECT_NEAR(d_m.y(), d_t.z(), 1e-15) << F_t.transpose();
+    EXPECT_NEAR(d_m.z(), d_t.y(), 1e-15) << F_t.transpose();
+  }
+}
+
 // Cut warm, measured at 20 °C: the workpiece shrinks about its datum (bottom centre).
 TEST(Machining, AWarmWorkpieceShrinksOnTheCmm) {
   const auto r = machine(truthFrom(R"(
