@@ -9,16 +9,20 @@
 
 namespace probeloop::campaign {
 
-StoreLiveLink::StoreLiveLink(CampaignStore& store, LiveLoop& loop, const std::string& folder)
+StoreLiveLink::StoreLiveLink(CampaignStore& store, LiveLoop& loop, const std::string& folder,
+                             const parts::Machine* machine)
     : store_(store), loop_(loop), folder_(folder) {
   std::filesystem::create_directories(folder);
   inputs_path_ = (std::filesystem::path(folder) / "inputs.csv").string();
   inputs_.open(inputs_path_, std::ios::trunc);
   if (!inputs_) throw InputError(inputs_path_, 0, "cannot write the live inputs file");
   const auto& m = store.manifest();
-  frame_.axis_centre_xy_mm = m.c_axis_centre_mm;
-  frame_.pivot_z_mm = m.table_surface_z_mm + (std::isfinite(m.sphere_centre_height_mm) ? m.sphere_centre_height_mm : 0.0);
-  frame_.reference_radius_mm = m.radius_from_axis_mm;
+  const double pivot_z = m.table_surface_z_mm + (std::isfinite(m.sphere_centre_height_mm) ? m.sphere_centre_height_mm : 0.0);
+  if (machine) frame_ = parts::machineOffsetFrame(*machine, pivot_z, m.radius_from_axis_mm);
+  // The C axis, the pivot and d/2 as the plan measured them (the manifest).
+  frame_.frame.table.axis_centre_xy_mm = m.c_axis_centre_mm;
+  frame_.frame.table.pivot_z_mm = pivot_z;
+  frame_.frame.table.reference_radius_mm = m.radius_from_axis_mm;
   points_per_cycle_ = static_cast<int>(m.spheres.size()) * m.pointsPerSphere();
   store.database().exec("PRAGMA synchronous = OFF");
 }
@@ -63,10 +67,10 @@ void StoreLiveLink::finish() {
   loop_.advance(true, false);
 }
 
-Eigen::Vector3d StoreLiveLink::offsetsUm(double t_s, const Eigen::Vector3d& tip_mm) {
+Eigen::Vector3d StoreLiveLink::offsetsUm(double t_s, const Eigen::Vector3d& tip_mm, double b_deg) {
   const auto c = loop_.compensationAt(t_s);
   if (!c) return Eigen::Vector3d::Zero();
-  const auto o = geometry::compensationOffsets(geometry::LocationErrors::fromValues(*c), tip_mm, frame_);
+  const auto o = frame_.offsetsAt(geometry::LocationErrors::fromValues(*c), tip_mm, b_deg);
   return {o.x_um, o.y_um, o.z_um};
 }
 

@@ -12,6 +12,7 @@
 #include "evaluate/sphere_campaign.hpp"
 #include "geometry/compensation_offsets.hpp"
 #include "parts/machine.hpp"
+#include "parts/machine_offsets.hpp"
 #include "parts/sphere_artifact.hpp"
 #include "planner/sphere_cycle.hpp"
 #include "sim/live_link.hpp"
@@ -31,7 +32,7 @@ struct ConstantPrediction : sim::LiveLink {
     if (line.rfind("PT", 0) == 0) ++points;
   }
   void inputSample(double, const std::string&, const std::string&) override {}
-  Eigen::Vector3d offsetsUm(double, const Eigen::Vector3d& tip_mm) override {
+  Eigen::Vector3d offsetsUm(double, const Eigen::Vector3d& tip_mm, double) override {
     if (points < points_per_cycle) return Eigen::Vector3d::Zero();
     const auto o = geometry::compensationOffsets(prediction, tip_mm, frame);
     return {o.x_um, o.y_um, o.z_um};
@@ -83,6 +84,58 @@ TEST(LiveLinkOnTheVirtualMachine, OffsetsShiftTheEvaluatedErrorsByMinusThePredic
       // The DPRNT log's 4 decimals (0.1 um) and the second order of 25 urad over 200 mm.
       EXPECT_NEAR(b[i] - a[i], -p[i], i < 4 ? 0.15 : 0.8) << geometry::LocationErrors::names()[i] << " cycle " << c + 1;
   }
+}
+
+// Records the B at which the machine asks for the offsets, and answers the trunnion's offsets
+// there (parts/machine_offsets.hpp): what StoreLiveLink does with the loop's prediction.
+struct RecordingLink : sim::LiveLink {
+  parts::MachineOffsetFrame frame;
+  geometry::LocationErrors prediction;
+  std::vector<std::pair<double, Eigen::Vector3d>> asked;  // B, offsets (um)
+  void logLine(double, const std::string&, const std::string&) override {}
+  void inputSample(double, const std::string&, const std::string&) override {}
+  Eigen::Vector3d offsetsUm(double, const Eigen::Vector3d& tip_mm, double b_deg) override {
+    const auto o = frame.offsetsAt(prediction, tip_mm, b_deg);
+    asked.emplace_back(b_deg, Eigen::Vector3d(o.x_um, o.y_um, o.z_um));
+    return asked.back().second;
+  }
+  std::optional<double> externalVariable(double, int) override { return std::nullopt; }
+  double analogInput(double, int) override { return 0; }
+};
+
+TEST(LiveLinkOnTheVirtualMachine, AsksForTheOffsetsAtTheBItStandsAt) {
+  const std::string src = PROBELOOP_SOURCE_DIR;
+  auto artifact = parts::loadSphereArtifact(src + "/parts/sphere_artifact.yaml");
+  const auto machine = parts::loadMachine(src + "/parts/machines/nmv5000.yaml");
+  const fs::path dir = fs::temp_directory_path() / ("probeloop_sim_link_b_test_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  std::ofstream(dir / "truth.yaml") << "kind: machine_truth\n";
+  const auto truth = sim::loadMachineTruth((dir / "truth.yaml").string());
+  fs::remove_all(dir);
+  RecordingLink link;
+  link.frame = parts::machineOffsetFrame(machine, 75, 160);
+  link.prediction.EX0C_um = 10, link.prediction.EZ0T_um = 4;
+  sim::SimulationPart part;
+  part.artifact = &artifact;
+  part.live = &link;
+  // Tip high above the table; B to -90 deg and back: the blocks after the B move run tilted.
+  sim::simulateProgram("tilt.nc", "%\nO1000\nG90 G00 Z600.\nB-90.\nX10.\nB0.\nX20.\nM30\n%\n", machine, part, truth, 1);
+  ASSERT_GE(link.asked.size(), 4u);
+  bool tilted = false;
+  for (const auto& [b, o] : link.asked) {
+    if (b == 0) {
+      EXPECT_NEAR(o.x(), 10, 1e-9);  // EX0C along X, EZ0T along Z with the table horizontal
+      EXPECT_NEAR(o.z(), 4, 1e-9);
+    } else {
+      // B' by -90 deg turns the table right-handedly about +Y by 90 deg: the C axis's +X shift
+      // points along -Z, its +Z shift along +X (seed 004 Eqs. 6.3, 6.5 with B^ = 90 deg).
+      tilted = true;
+      EXPECT_EQ(b, -90.0);
+      EXPECT_NEAR(o.x(), 4, 1e-9);
+      EXPECT_NEAR(o.z(), -10, 1e-9);
+    }
+  }
+  EXPECT_TRUE(tilted);
 }
 
 }  // namespace

@@ -18,6 +18,7 @@ Subcommand addPlanCommand(CLI::App& app);
 Subcommand addReadCommand(CLI::App& app);
 Subcommand addResolutionCommand(CLI::App& app);
 Subcommand addSynthCommand(CLI::App& app);
+Subcommand addLatheCommand(CLI::App& app);  // the seed 002 turning centre's campaign
 Subcommand addSimulateCommand(CLI::App& app);
 Subcommand addCheckCommand(CLI::App& app);
 Subcommand addEvaluateCommand(CLI::App& app);

@@ -48,6 +48,8 @@ int runEvaluate(const EvaluateArgs& a) {
   writeFileAtomic(pathIn(a.out, evaluate::EvaluationFiles::kReportMd), f.report_md);
   if (!f.compensation_json.empty()) writeFileAtomic(pathIn(a.out, "compensation.json"), f.compensation_json);
   if (!f.results_qif.empty()) writeFileAtomic(pathIn(a.out, evaluate::EvaluationFiles::kResultsQif), f.results_qif);
+  if (!f.rotary_json.empty()) writeFileAtomic(pathIn(a.out, evaluate::EvaluationFiles::kRotaryJson), f.rotary_json);
+  if (!f.rotary_csv.empty()) writeFileAtomic(pathIn(a.out, evaluate::EvaluationFiles::kRotaryCsv), f.rotary_csv);
   std::fputs(f.stdout_text.c_str(), stdout);
   if (!scene.empty()) {
     writeFileAtomic(a.scene, scene);

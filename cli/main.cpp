@@ -24,7 +24,8 @@ int main(int argc, char** argv) {
                                         cli::addResolutionCommand(app), cli::addSynthCommand(app),
                                         cli::addSimulateCommand(app), cli::addCheckCommand(app),
                                         cli::addEvaluateCommand(app), cli::addFitCommand(app),
-                                        cli::addGumCommand(app),      cli::addCampaignCommands(app)};
+                                        cli::addGumCommand(app),      cli::addCampaignCommands(app),
+                                        cli::addLatheCommand(app)};
   cli::Subcommand model, report, separate;
   model.run = cli::addModelCommands(app, model.app);
   report.run = cli::addReportCommands(app, report.app);

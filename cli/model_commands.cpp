@@ -116,7 +116,7 @@ int runAdd(const ModelArgs& a) {
   auto m = parts::loadErrorModel(a.model);
   const auto kind = model::kindFromName(a.kind);
   if (!kind || *kind == model::EffectKind::Offset)
-    throw InputError("", 0, "model add: unknown effect '" + a.kind + "'; the effects are drift, static, lag, transient, expansion");
+    throw InputError("", 0, "model add: unknown effect '" + a.kind + "'; the effects are drift, static, lag, transient, expansion, force");
   std::vector<std::string> chans;
   std::stringstream ss(a.channels);
   for (std::string s; std::getline(ss, s, ',');) {
@@ -275,8 +275,8 @@ std::function<int()> addModelCommands(CLI::App& app, CLI::App*& group) {
   dia->add_option("--part", a->part, "the test piece (YAML: sphere artifact, thermal test piece): enables its expansion candidates")->check(cli::inputFile());
   dia->add_option("--html", a->html, "also write the HTML report to this file");
   auto* add = group->add_subcommand("add", "Add an effect to channels of a model file (marked just_added: the next fit shows before and after)");
-  add->add_option("effect", a->kind, "drift, static, lag, transient or expansion")
-      ->required()->check(CLI::IsMember({"drift", "static", "lag", "transient", "expansion"}));
+  add->add_option("effect", a->kind, "drift, static, lag, transient, expansion or force")
+      ->required()->check(CLI::IsMember({"drift", "static", "lag", "transient", "expansion", "force"}));
   add->add_option("--model", a->model, "error model file to edit")->required()->check(cli::inputFile());
   add->add_option("--channels", a->channels, "comma-separated channels, e.g. EY0C_um,EZ0T_um")->required();
   add->add_option("--input", a->input, "inputs.csv column the effect reads");

@@ -57,7 +57,7 @@ int runSimulate(const SimulateArgs& a) {
     o.talc.inputs = talcInputsFrom(a.talc_inputs);
     o.offsets_applied = true;
     loop = std::make_unique<campaign::LiveLoop>(*store, o);
-    link = std::make_unique<campaign::StoreLiveLink>(*store, *loop, live_dir);
+    link = std::make_unique<campaign::StoreLiveLink>(*store, *loop, live_dir, &machine);
     part.live = link.get();
   }
   const auto s = sim::simulatePrograms(programs, machine, part, truth, a.seed);

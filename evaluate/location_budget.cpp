@@ -179,7 +179,7 @@ std::array<uncertainty::Budget, 7> predictLocationErrorBudgets(const parts::Plan
   std::vector<double> angles;
   std::vector<int> positions;
   for (const auto& s : m.spheres)
-    if (s.repeat_of == 0) angles.push_back(s.angle_deg), positions.push_back(s.position);
+    if (s.usedForCAxis()) angles.push_back(s.angle_deg), positions.push_back(s.position);
   const LocationLeastSquares ls(angles, m.radius_from_axis_mm);
   CycleBudgetInput planned;
   const int per = m.pointsPerSphere();

@@ -35,9 +35,13 @@ struct EvaluationFiles {
   static constexpr const char* kEvaluationJson = "evaluation.json";
   static constexpr const char* kReportMd = "report.md";
   static constexpr const char* kResultsQif = "results.qif";
+  static constexpr const char* kRotaryJson = "rotary_calibration.json";
+  static constexpr const char* kRotaryCsv = "rotary_errors.csv";
   std::string errors_csv, evaluation_json, report_md, stdout_text;
   std::string compensation_json;  // stepped workpiece: compensation.json (empty for the other kinds)
   std::string results_qif;        // results.qif: the measured features and the errors as QIF 3.0 (qif_results.hpp)
+  // Sphere artifact with tilted positions: every rotary axis on the chain (rotary_calibration.hpp).
+  std::string rotary_json, rotary_csv;
   // Sphere artifact: the campaign, for --scene (per-cycle sphere centres, reference cycle).
   std::optional<CampaignEvaluation> sphere;
   std::optional<TtpEvaluation> thermal_test_piece;

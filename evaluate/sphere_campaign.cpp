@@ -25,7 +25,7 @@ struct Layout {
 Layout layoutOf(const parts::PlanManifest& m) {
   Layout l;
   for (const auto& s : m.spheres) {
-    if (s.repeat_of == 0) {
+    if (s.usedForCAxis()) {
       l.ls_positions.push_back(s.position);
       l.ls_angles.push_back(s.angle_deg);
     }

@@ -22,7 +22,12 @@
 // - the printed Z has its origin at the NC zero (Fig. 6.11): the tilt's pivot is where the
 //   location errors were measured, which for the sphere cycle is the sphere centre's height,
 //   so r_z = Z - pivot_z.
-// B != 0 (trunnion machines) is issue 33's kinematic chain; not here.
+// B != 0 (the B/C trunnion of seed 004, issue 33 item 3): the C axis's errors were measured at
+// B = 0 and hold in the trunnion's frame, so they turn with it. The first-order propagation
+// through the chain frame -> B -> C: take the tip back to where the table point under it sits
+// at B = 0, displace it there as above, turn the displacement by B. The kinematic chain gives
+// the same to first order (geometry/chain_offsets.hpp, tested at every B); the printed
+// equations, term by term: docs/kinematic-offsets.md.
 #pragma once
 #include <Eigen/Dense>
 
@@ -42,8 +47,26 @@ struct OffsetFrame {
 
 AxisOffsets compensationOffsets(const LocationErrors& e, const Eigen::Vector3d& tip_mm, const OffsetFrame& f);
 
+// A C table on a B trunnion (parts/machine_chain.hpp; parts/machines/nmv5000.yaml).
+struct TrunnionFrame {
+  OffsetFrame table;                                         // the C axis at B = 0
+  Eigen::Vector2d b_axis_xz_mm = Eigen::Vector2d::Zero();   // B's axis line (parallel to Y) at B = 0
+  // +1: +B turns the table right-handedly about +Y; -1: about -Y (B' on the workpiece side,
+  // clockwise seen from +Y: parts::RotaryAxis::positive_is_clockwise).
+  double b_sense = -1;
+};
+
+// At B = 0 exactly the B = 0 function above (the same bytes); tip_mm: commanded tip, machine
+// coordinates; b_deg: the B axis's commanded position.
+AxisOffsets compensationOffsets(const LocationErrors& e, const Eigen::Vector3d& tip_mm, double b_deg,
+                                const TrunnionFrame& f);
+
 // The printed Eqs. 6.3-6.5 at B = 0 verbatim (E_C0C of the text = EC0C here), X Y Z from the
 // NC origin: kept to show, in a test, where the derivation departs from the print.
 AxisOffsets printedOffsetsB0(const LocationErrors& e, double x_mm, double y_mm, double z_mm, double half_d_mm);
+// Eqs. 6.3-6.5 verbatim at any B^ (deg; the print does not say which way B^ turns the table:
+// docs/kinematic-offsets.md), E_C0C of the text = EC0C here, X^ Y^ Z^ from the print's origin.
+AxisOffsets printedOffsets(const LocationErrors& e, double x_mm, double y_mm, double z_mm, double b_hat_deg,
+                           double half_d_mm);
 
 }  // namespace probeloop::geometry

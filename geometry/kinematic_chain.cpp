@@ -21,19 +21,23 @@ Isometry3d translation(const Vector3d& v) {
   return t;
 }
 
+Isometry3d turn(const Vector3d& direction, double rad) {
+  Isometry3d r = Isometry3d::Identity();
+  r.linear() = AngleAxisd(rad, direction).toRotationMatrix();
+  return r;
+}
+
 // Parent -> body at the state's position, with the body's error twists.
 Isometry3d bodyTransform(const Body& b, const ChainState& s, int index) {
   const Vector3d& p = b.joint.point_mm;
   Isometry3d t = translation(b.origin_mm);
-  if (index < static_cast<int>(s.location.size()) && !s.location[index].isZero())
-    t = t * translation(p) * twistTransform(s.location[index]) * translation(-p);
+  const bool located = index < static_cast<int>(s.location.size()) && !s.location[index].isZero();
   const double q = b.joint.kind == JointKind::Fixed ? 0.0 : s.position(b.joint.axis);
-  if (b.joint.kind == JointKind::Linear) {
-    t = t * translation(q * b.joint.direction);
-  } else if (b.joint.kind == JointKind::Rotary && q != 0) {
-    Isometry3d r = Isometry3d::Identity();
-    r.linear() = AngleAxisd(q * kDegToRad, b.joint.direction).toRotationMatrix();
-    t = t * translation(p) * r * translation(-p);
+  if (b.joint.kind == JointKind::Rotary) {
+    t = t * rotaryJointTransform(b.joint, q, located ? s.location[index] : Twist{});
+  } else {
+    if (located) t = t * translation(p) * twistTransform(s.location[index]) * translation(-p);
+    if (b.joint.kind == JointKind::Linear) t = t * translation(q * b.joint.direction);
   }
   if (index < static_cast<int>(s.motion.size()) && !s.motion[index].isZero()) t = t * twistTransform(s.motion[index]);
   return t;
@@ -46,6 +50,21 @@ Isometry3d branch(const std::vector<Body>& bodies, const ChainState& s, int firs
 }
 
 }  // namespace
+
+Isometry3d rotaryJointTransform(const Joint& j, double q_deg, const Twist& e) {
+  const Vector3d& p = j.point_mm;
+  const Vector3d& d = j.direction;
+  if (e.isZero()) return q_deg == 0 ? Isometry3d::Identity() : translation(p) * turn(d, q_deg * kDegToRad) * translation(-p);
+  if (j.location_convention == LocationConvention::BodyOnAxis)
+    return translation(p) * twistTransform(e) * turn(d, q_deg * kDegToRad) * translation(-p);
+  // The line: displaced and tilted across the axis (what lies along it is no error of a line);
+  // the zero: a turn about it.
+  Twist line;
+  line.translation_mm = e.translation_mm - e.translation_mm.dot(d) * d;
+  line.rotation_rad = e.rotation_rad - e.rotation_rad.dot(d) * d;
+  const Isometry3d L = twistTransform(line);
+  return translation(p) * L * turn(d, q_deg * kDegToRad + e.rotation_rad.dot(d)) * L.inverse() * translation(-p);
+}
 
 Isometry3d twistTransform(const Twist& e) {
   Isometry3d t = Isometry3d::Identity();

@@ -7,8 +7,14 @@
 // nominal direction and, for a rotary joint, a point of its axis line, in the parent frame.
 // On each body act two small error twists (translation mm, rotation rad):
 // - `location`: the joint's location errors (ISO 230-1: position and orientation of the axis
-//   line, zero position), constant, applied about the joint's reference point before the
-//   motion; on a linear joint its rotation tilts the direction of travel (squareness);
+//   line, zero position), constant, about the joint's reference point. On a linear joint it
+//   acts before the motion, so its rotation tilts the direction of travel (squareness). On a
+//   rotary joint it acts as Joint::location_convention says:
+//   AxisLine (ISO 230-7, the default): the body turns about the displaced and tilted line;
+//   the twist's part along the axis direction is the zero error; at q = 0 only the zero acts.
+//   BodyOnAxis (seed 004's C table): the body is square to its axis and carries its error,
+//   so the whole twist acts at every q, C's turn first (error x turn): the table tilts with
+//   a tilted axis, as seed 004's model of the sphere centres has it;
 // - `motion`: the component errors at the current position (positioning, straightness,
 //   roll/pitch/yaw of a carriage; radial/axial/tilt motion of a spindle), applied after the
 //   motion about the body's own origin. The caller evaluates them at the axis positions.
@@ -37,7 +43,15 @@ struct Twist {
 // The exact transformation of an error twist: Trans(d) Rot(x,ex) Rot(y,ey) Rot(z,ez).
 Eigen::Isometry3d twistTransform(const Twist& e);
 
+struct Joint;
+// A rotary joint's motion by q_deg with its location errors (the convention of the joint),
+// in the parent frame; the simulator's tilting table uses it, so the truth and the
+// evaluation's model cannot differ.
+Eigen::Isometry3d rotaryJointTransform(const Joint& joint, double q_deg, const Twist& location);
+
 enum class JointKind { Fixed, Linear, Rotary };
+
+enum class LocationConvention { AxisLine, BodyOnAxis };
 
 struct Joint {
   JointKind kind = JointKind::Fixed;
@@ -45,6 +59,7 @@ struct Joint {
   Eigen::Vector3d direction = Eigen::Vector3d::UnitZ();    // unit, parent frame
   Eigen::Vector3d point_mm = Eigen::Vector3d::Zero();      // rotary: on the axis line; the
                                                            // location errors' reference point
+  LocationConvention location_convention = LocationConvention::AxisLine;  // rotary joints
 };
 
 struct Body {

@@ -21,7 +21,7 @@ constexpr double kPi = 3.14159265358979323846;
 KinematicChain trunnion(double zb, double cx, double cy, double zc) {
   KinematicChain c;
   Body b{"B trunnion", Vector3d::Zero(), {JointKind::Rotary, "B", -Vector3d::UnitY(), Vector3d(0, 0, zb)}};
-  Body t{"C table", Vector3d::Zero(), {JointKind::Rotary, "C", -Vector3d::UnitZ(), Vector3d(cx, cy, zc)}};
+  Body t{"C table", Vector3d::Zero(), {JointKind::Rotary, "C", -Vector3d::UnitZ(), Vector3d(cx, cy, zc), LocationConvention::BodyOnAxis}};
   c.workpiece_branch = {b, t};
   const char* n[3] = {"X", "Y", "Z"};
   for (int k = 0; k < 3; ++k) c.tool_branch.push_back(Body{std::string(n[k]), Vector3d::Zero(), {JointKind::Linear, n[k], Vector3d::Unit(k), Vector3d::Zero()}});
@@ -108,7 +108,7 @@ TEST(Identifiability, CPositionsAloneCannotSeeTheBAxis) {
   const Vector3d w(-160, 0, 75);
   const auto only_c = identifiability(sphereCentresSensitivity(chain, {{0, 0}, {0, 90}, {0, 180}, {0, 270}}, w, p), namesOf(p));
   EXPECT_FALSE(only_c.all());
-  // B's orientation errors do nothing at B = 0; its position equals C's position there.
+  // B's line errors do nothing at B = 0 (ISO 230-7: the line; C's errors hold at B = 0).
   for (const char* who : {"EA0B", "EC0B", "EX0B", "EZ0B"}) {
     const auto it = std::find(only_c.names.begin(), only_c.names.end(), who);
     EXPECT_FALSE(only_c.identifiable[static_cast<std::size_t>(it - only_c.names.begin())]) << who;

@@ -64,6 +64,8 @@ std::vector<Effect> candidatesFor(const Campaign& c, const ChannelModel& cm, con
           e.length_mm = *L;
           if (e.alpha_um_per_m_K > 0) add(e);
         }
+    } else if (isForceInput(name)) {
+      add(makeEffect(EffectKind::Force, name));  // a compliance, instead of a static gain on it
     } else if (name == "tool_changes") {
       add(makeEffect(EffectKind::Transient, name));
     } else if (isSpeedInput(name) || endsWith(name, "_on")) {
@@ -110,6 +112,9 @@ std::string physics(const Effect& e, const std::string& what) {
       if (in.find("env") != std::string::npos || in.find("hall") != std::string::npos)
         return "the hall temperature reaches the structure with a delay (a door, the day/night cycle): model it as a lag, not a static gain";
       return "the structure takes up the temperature at " + in + " with a delay";
+    case EffectKind::Force:
+      return "the cutting force " + in + " deflects the structure and the tool (seed 003: the crossbeam's and bed's F/(4k) "
+             "and F R/(k S^2) x arm); stiffen the weak unit, lower the force, or compensate the deflection";
     case EffectKind::Offset: break;
   }
   return "";
@@ -128,6 +133,7 @@ std::string sentence(const Recommendation& r, const std::string& what) {
       return chs + verb + "each tool change and settle" + (r.channels.size() > 1 ? "" : "s") + " with tau ~" +
              minutes(*e.tau_s) + ": " + physics(e, what) + ".";
     case EffectKind::Static: return chs + verb + e.input + " with no delay: " + physics(e, what) + ".";
+    case EffectKind::Force: return chs + verb + "the force " + e.input + " (a compliance in um/N): " + physics(e, what) + ".";
     case EffectKind::Lag:
       if (!e.lever.empty())
         return chs + verb + (isSpeedInput(e.input) ? e.input + " (its magnitude)" : e.input) + " through a lag of ~" +

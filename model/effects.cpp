@@ -38,13 +38,14 @@ const char* kindName(EffectKind k) {
     case EffectKind::Lag: return "lag";
     case EffectKind::Transient: return "transient";
     case EffectKind::Expansion: return "expansion";
+    case EffectKind::Force: return "force";
   }
   return "?";
 }
 
 std::optional<EffectKind> kindFromName(const std::string& name) {
   for (EffectKind k : {EffectKind::Offset, EffectKind::Drift, EffectKind::Static, EffectKind::Lag,
-                       EffectKind::Transient, EffectKind::Expansion})
+                       EffectKind::Transient, EffectKind::Expansion, EffectKind::Force})
     if (name == kindName(k)) return k;
   return std::nullopt;
 }
@@ -58,6 +59,8 @@ bool isSpeedInput(const std::string& c) {
   auto ends = [&](const std::string& s) { return c.size() >= s.size() && c.compare(c.size() - s.size(), s.size(), s) == 0; };
   return ends("_rpm") || c.rfind("feed", 0) == 0;
 }
+
+bool isForceInput(const std::string& c) { return c.size() > 2 && c.compare(c.size() - 2, 2, "_N") == 0; }
 
 std::vector<double> regressor(const Effect& e, const std::vector<double>& t, const std::vector<double>& u,
                               double tau_s) {
@@ -73,6 +76,9 @@ std::vector<double> regressor(const Effect& e, const std::vector<double>& t, con
       break;
     case EffectKind::Static:
       for (std::size_t k = 0; k < n; ++k) r[k] = u[k] - u[0];
+      break;
+    case EffectKind::Force:  // seed 003 eqs. 28, 29: deflection = compliance x F
+      r = u;
       break;
     case EffectKind::Expansion:
       for (std::size_t k = 0; k < n; ++k) r[k] = expansion_um(e.alpha_um_per_m_K, e.length_mm, u[k] - u[0]);

@@ -17,6 +17,11 @@
 //   transient  k s,  s jumps by each event, tau ds/dt = -s   (tool changes: a settling step)
 //   expansion  alpha L (T - T0)                    artifact/workpiece/table growth; alpha and
 //                                                  L are known, nothing is fitted
+//   force      c F                                 force-induced deflection: a compliance c
+//                                                  (um/N) times a cutting-force input (a column
+//                                                  in N, e.g. F_y_N); seed 003's F/(4k) and
+//                                                  F R/(k S^2) x arm are both linear in F
+//                                                  (model/structural_stiffness.hpp)
 // A static or lag effect may act over a lever: its regressor times another inputs column
 // (`lever`), e.g. lag(spindle_rpm) x travel_mm: a warmed screw or frame stretches its axis, an
 // error that grows with the heat and with the distance (seed 000's thermal position error e_pt).
@@ -48,7 +53,7 @@ struct ExpansionLevers {
   std::optional<double> lengthFor(const std::string& channel) const;
 };
 
-enum class EffectKind { Offset, Drift, Static, Lag, Transient, Expansion };
+enum class EffectKind { Offset, Drift, Static, Lag, Transient, Expansion, Force };
 
 struct Effect {
   EffectKind kind = EffectKind::Offset;
@@ -60,7 +65,8 @@ struct Effect {
   std::string lever;                 // static/lag: the regressor times this inputs column ("" none)
   bool just_added = false;           // set by `probeloop model add`: "before" leaves it out
 
-  std::string id() const;            // e.g. "lag(c_rpm)", "offset", "expansion(T_table_C)", "lag(spindle_rpm)*travel_mm"
+  std::string id() const;            // e.g. "lag(c_rpm)", "offset", "expansion(T_table_C)", "lag(spindle_rpm)*travel_mm",
+                                     // "force(F_y_N)"
   bool hasTimeConstant() const { return kind == EffectKind::Lag || kind == EffectKind::Transient; }
   bool fitsGain() const { return kind != EffectKind::Expansion; }
 };
@@ -71,11 +77,14 @@ std::optional<EffectKind> kindFromName(const std::string& name);
 
 // A heat-source proxy is driven by its magnitude (a speed heats whichever way it turns).
 bool isSpeedInput(const std::string& column);
+// A force input: a column in newtons (name ending in _N, e.g. F_y_N).
+bool isForceInput(const std::string& column);
 
 // The regressor of an effect on a uniform time grid (t[0], t[0] + step, ...), from the input
 // column u on that grid; tau_s for lag/transient. A lag starts in equilibrium with u[0]; a
 // transient starts at rest and an event counted in sample k happened half a step before t_k.
-// Expansion returns alpha L (T - T[0]) in um (the fixed prediction, not a regressor).
+// Expansion returns alpha L (T - T[0]) in um (the fixed prediction, not a regressor). Force
+// returns F itself (no force, no deflection; the channel's offset is its error at F = 0).
 std::vector<double> regressor(const Effect& e, const std::vector<double>& t_s, const std::vector<double>& u,
                               double tau_s);
 

@@ -173,6 +173,7 @@ std::string inputUnit(const std::string& c) {
   if (endsWith(c, "_mm_per_min")) return "(mm/min)";
   if (endsWith(c, "_mm")) return "mm";
   if (endsWith(c, "_um")) return "um";
+  if (endsWith(c, "_N")) return "N";
   if (endsWith(c, "_on")) return "on";
   if (c == "tool_changes") return "change";
   return "unit";

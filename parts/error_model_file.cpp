@@ -20,7 +20,7 @@ using model::EffectKind;
 namespace {
 
 Effect readEffect(YamlMap& m) {
-  const std::string kind = m.choice("effect", {"drift", "static", "lag", "transient", "expansion"});
+  const std::string kind = m.choice("effect", {"drift", "static", "lag", "transient", "expansion", "force"});
   Effect e = model::makeEffect(*model::kindFromName(kind));
   if (e.kind != EffectKind::Drift) e.input = m.string("input");
   if (e.hasTimeConstant()) {

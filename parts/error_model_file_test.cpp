@@ -130,3 +130,17 @@ TEST(ErrorModelFile, PatchKeepsCommentsAndMeansTheUpdatedModel) {
   f.channels[0].effects.push_back(lag);
   EXPECT_FALSE(parts::patchErrorModelText(flow, f).has_value());
 }
+
+// Seed 003's force-induced error as written in a model file (docs/formats.md#error-model).
+TEST(ErrorModelFile, ReadsAndWritesTheForceEffect) {
+  const std::string text =
+      "kind: error_model\nchannels:\n  EY_um:\n    - {effect: force, input: F_y_N}\n";
+  const auto m = parts::errorModelFromText(text, "m.yaml");
+  ASSERT_EQ(m.channels.size(), 1u);
+  ASSERT_EQ(m.channels[0].effects.size(), 1u);
+  EXPECT_EQ(m.channels[0].effects[0].kind, model::EffectKind::Force);
+  EXPECT_EQ(m.channels[0].effects[0].id(), "force(F_y_N)");
+  EXPECT_NE(parts::errorModelYaml(m).find("- {effect: force, input: \"F_y_N\"}"), std::string::npos) << parts::errorModelYaml(m);
+  EXPECT_THROW(parts::errorModelFromText("kind: error_model\nchannels:\n  EY_um:\n    - {effect: force, input: F_y_N, lever: x_mm}\n", "m.yaml"),
+               InputError);
+}

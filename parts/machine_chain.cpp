@@ -46,6 +46,9 @@ geometry::KinematicChain machineChain(const Machine& m, std::optional<double> c_
     c.name = "C table";
     c.joint.kind = JointKind::Rotary;
     c.joint.axis = "C";
+    // The table is square to its axis and carries its error (seed 004's model: EA0C tilts the
+    // table and the sphere on it); the tilting axis is a line (ISO 230-7, the default).
+    c.joint.location_convention = geometry::LocationConvention::BodyOnAxis;
     c.joint.direction = Vector3d::UnitZ() * (m.c.positive_is_clockwise ? -1.0 : 1.0);
     c.joint.point_mm = Vector3d(m.c_axis_centre_mm.x(), m.c_axis_centre_mm.y(),
                                 c_reference_z_mm.value_or(m.table_surface_z_mm));

@@ -6,6 +6,10 @@
 // axis moves the table by -q so that +X still moves the tool +X relative to the workpiece.
 // Rotary directions follow Machine::RotaryAxis::positive_is_clockwise (C' turns about -Z).
 //
+// Location errors: C's are seed 004's, the table square to its axis and carrying its error
+// (LocationConvention::BodyOnAxis), in the machine frame at A = B = 0; the tilting axis's are
+// those of its line (ISO 230-7, AxisLine): at A = B = 0 they move nothing but its zero.
+//
 // Coordinates are tip coordinates (the probe's length offset active): at all-zero errors
 // machineCoordinatesOf(point) of a table point at C = B = 0 is that point.
 //

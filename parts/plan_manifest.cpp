@@ -53,6 +53,12 @@ Eigen::Vector3d readVec(const ordered_json& j, const std::string& file, const st
   }
   return v;
 }
+
+Eigen::Vector2d readVec2(const ordered_json& j, const std::string& file, const std::string& what) {
+  if (!j.is_array() || j.size() != 2 || !j[0].is_number() || !j[1].is_number())
+    throw InputError(file, 0, what + ": expected an array of 2 numbers");
+  return {j[0].get<double>(), j[1].get<double>()};
+}
 }  // namespace
 
 namespace {
@@ -65,11 +71,16 @@ double optional(const ordered_json& j, const char* key) {
 namespace {
 
 ordered_json machineJson(const PlanManifest& m) {
-  return {{"name", m.machine_name},
+  ordered_json j = {{"name", m.machine_name},
                   {"c_axis_centre_mm", {m.c_axis_centre_mm.x(), m.c_axis_centre_mm.y()}},
                   {"c_positive_is_clockwise", m.c_positive_is_clockwise},
                   {"table_surface_z_mm", m.table_surface_z_mm},
                   {"coordinate_resolution_mm", m.coordinate_resolution_mm}};
+  if (m.tilt_axis)
+    j["tilt_axis"] = {{"name", m.tilt_axis->name},
+                      {"centre_mm", {m.tilt_axis->centre_mm.x(), m.tilt_axis->centre_mm.y()}},
+                      {"positive_is_clockwise", m.tilt_axis->positive_is_clockwise}};
+  return j;
 }
 
 ordered_json probeJson(const PlanManifest& m) {
@@ -202,7 +213,7 @@ std::string manifestToJson(const PlanManifest& m) {
                    {"alpha_um_per_m_K", orNull(m.artifact_alpha_um_per_m_K)},
                    {"temperature_change_half_width_K", orNull(m.artifact_temperature_change_half_width_K)}};
   for (const auto& s : m.spheres) {
-    j["features"].push_back({{"id", s.id},
+    ordered_json f = {{"id", s.id},
                              {"kind", "sphere"},
                              {"position", s.position},
                              {"c_deg", s.c_deg},
@@ -210,7 +221,9 @@ std::string manifestToJson(const PlanManifest& m) {
                              {"nominal_centre_mm", vec(s.nominal_centre_mm)},
                              {"radius_mm", m.sphere_radius_mm},
                              {"formula_index", s.formula_index},
-                             {"repeat_of", s.repeat_of}});
+                             {"repeat_of", s.repeat_of}};
+    if (m.tilt_axis) f["tilt_deg"] = s.tilt_deg;
+    j["features"].push_back(f);
   }
   for (const auto& p : m.points) {
     j["points"].push_back({{"feature", p.feature},
@@ -434,6 +447,15 @@ PlanManifest parseManifest(const std::string& text, const std::string& path) {
     m.c_axis_centre_mm = Eigen::Vector2d(mc.at("c_axis_centre_mm").at(0).get<double>(),
                                          mc.at("c_axis_centre_mm").at(1).get<double>());
     m.c_positive_is_clockwise = mc.at("c_positive_is_clockwise");
+    if (mc.contains("tilt_axis")) {
+      const auto& ta = mc.at("tilt_axis");
+      ManifestTiltAxis t;
+      t.name = ta.at("name").get<std::string>();
+      if (t.name != "A" && t.name != "B") throw InputError(path, 0, "machine.tilt_axis.name: expected \"A\" or \"B\"");
+      t.centre_mm = readVec2(ta.at("centre_mm"), path, "machine.tilt_axis.centre_mm");
+      t.positive_is_clockwise = ta.at("positive_is_clockwise");
+      m.tilt_axis = t;
+    }
     m.table_surface_z_mm = mc.at("table_surface_z_mm");
     m.coordinate_resolution_mm = mc.at("coordinate_resolution_mm");
     const auto& pr = j.at("probe");
@@ -462,6 +484,8 @@ PlanManifest parseManifest(const std::string& text, const std::string& path) {
       s.nominal_centre_mm = readVec(f.at("nominal_centre_mm"), path, "features[].nominal_centre_mm");
       s.formula_index = f.at("formula_index");
       s.repeat_of = f.at("repeat_of");
+      s.tilt_deg = f.value("tilt_deg", 0.0);
+      if (!std::isfinite(s.tilt_deg)) throw InputError(path, 0, "features[].tilt_deg: not a finite number");
       m.spheres.push_back(s);
     }
     for (const auto& p : j.at("points")) {

@@ -31,6 +31,17 @@ struct ManifestSphere {
   Eigen::Vector3d nominal_centre_mm = Eigen::Vector3d::Zero();
   int formula_index = 0;  // 1..4: index k of seed 004 Eqs. 5.4-5.10; 0 = not used there
   int repeat_of = 0;      // position this one repeats (same angle), 0 = none
+  double tilt_deg = 0;    // the tilting axis (PlanManifest::tilt_axis) at this position
+  // Seed 004's C-axis evaluation uses the level positions that repeat no other.
+  bool usedForCAxis() const { return repeat_of == 0 && tilt_deg == 0; }
+};
+
+// The machine's tilting axis when the plan tilts the table (issue 33): its line at tilt 0
+// (B: parallel to Y through (x, z); A: parallel to X through (y, z)) and its sense.
+struct ManifestTiltAxis {
+  std::string name;  // "A" or "B"
+  Eigen::Vector2d centre_mm = Eigen::Vector2d::Zero();
+  bool positive_is_clockwise = true;  // seen from +X (A) or +Y (B)
 };
 
 struct ManifestPoint {
@@ -119,6 +130,7 @@ struct PlanManifest {
   std::string machine_name;
   Eigen::Vector2d c_axis_centre_mm = Eigen::Vector2d::Zero();
   bool c_positive_is_clockwise = true;
+  std::optional<ManifestTiltAxis> tilt_axis;  // written only when a position tilts the table
   double table_surface_z_mm = 0;
   double coordinate_resolution_mm = 0.001;
   // Probe and artifact.

@@ -34,6 +34,23 @@ SphereArtifact loadSphereArtifact(const std::string& path) {
   if (a.c_positions_deg.size() < 3)
     root.fail("c_positions", "at least 3 C positions are needed to separate the location errors");
 
+  if (root.has("tilted_positions"))
+    for (auto& t : root.mapList("tilted_positions")) {
+      SphereArtifact::TiltedPosition tp;
+      tp.line = t.line();
+      const bool b = t.has("B"), has_a = t.has("A");
+      if (b == has_a) t.fail(b ? "A" : "B", "a tilted position names one tilting axis, B or A (and C)");
+      tp.tilt_deg = t.quantity(b ? "B" : "A", Dimension::Angle);
+      tp.c_deg = t.quantity("C", Dimension::Angle);
+      if (tp.tilt_deg == 0) t.fail(b ? "B" : "A", "0 is not tilted: list it under c_positions");
+      const char letter = b ? 'B' : 'A';
+      if (a.tilt_axis && a.tilt_axis != letter)
+        t.fail(b ? "B" : "A", std::string("every tilted position tilts the same axis (") + a.tilt_axis + " above)");
+      a.tilt_axis = letter;
+      t.finish();
+      a.tilted_positions.push_back(tp);
+    }
+
   YamlMap pr = root.map("probing");
   a.equator_points = pr.integer("equator_points");
   a.top_point = pr.boolean("top_point");

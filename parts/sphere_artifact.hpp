@@ -16,6 +16,12 @@ struct SphereArtifact {
   double radius_from_axis_mm = 160;    // d/2 (seed 004: 0.16 m)
   double angle_at_c0_deg = 180;        // sphere angle about C at C = 0, seen from +Z, from +X
   std::vector<double> c_positions_deg{0, 90, 180, 270, 360};
+  // Positions with the table tilted (issue 33), after the C positions: the tilting axis's
+  // angle (A or B, the machine's) and C. They calibrate the tilting axis's location errors
+  // beside C's (evaluate/rotary_calibration.hpp); the C positions alone keep seed 004's seven.
+  struct TiltedPosition { double tilt_deg = 0, c_deg = 0; int line = 0; };
+  std::vector<TiltedPosition> tilted_positions;
+  char tilt_axis = 0;  // 'A' or 'B' when tilted_positions is not empty
   // Probing: `equator_points` lateral points at machine angles 0, 360/n, ... (+X first)
   // plus the top point; all stylus-tip centres.
   int equator_points = 4;

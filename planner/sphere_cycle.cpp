@@ -8,6 +8,7 @@
 #include "core/csv.hpp"
 #include "core/error.hpp"
 #include "core/units.hpp"
+#include "parts/machine_chain.hpp"
 #include "parts/machine_clock.hpp"
 #include "planner/angles.hpp"
 
@@ -82,6 +83,18 @@ class Walker {
     t_->c_index_s += parts::rotaryIndexSeconds(r.c_deg - c_, m_.c);
     c_ = r.c_deg;
   }
+  void step(const gcode::RotateB& r, const std::string& where) {
+    if (!m_.b.continuous && (r.b_deg < m_.b.min_deg || r.b_deg > m_.b.max_deg))
+      throw SafetyError(where + ": B = " + formatNumber(r.b_deg, 3) + " deg is outside the B travel");
+    t_->c_index_s += parts::rotaryIndexSeconds(r.b_deg - b_, m_.b);
+    b_ = r.b_deg;
+  }
+  void step(const gcode::RotateA& r, const std::string& where) {
+    if (!m_.a.continuous && (r.a_deg < m_.a.min_deg || r.a_deg > m_.a.max_deg))
+      throw SafetyError(where + ": A = " + formatNumber(r.a_deg, 3) + " deg is outside the A travel");
+    t_->c_index_s += parts::rotaryIndexSeconds(r.a_deg - a_, m_.a);
+    a_ = r.a_deg;
+  }
   void step(const gcode::ToolChange& tc, const std::string&) {
     t_->tool_change_s += m_.tool_change.time_s;
     length_ = tc.apply_length_offset ? m_.probe.length_mm : 0.0;
@@ -110,7 +123,7 @@ class Walker {
   CycleTime* t_;
   Vector3d gauge_;
   double length_ = 0.0;
-  double c_ = 0.0;
+  double c_ = 0.0, b_ = 0.0, a_ = 0.0;
   Vector3d contact_ = Vector3d::Zero();
 };
 
@@ -155,12 +168,50 @@ SpherePlan planSphereCycle(const SphereArtifact& a, const Machine& m, const Plan
       }
     man.spheres.push_back(s);
   }
+  // Tilted positions (issue 33): the sphere centre where the machine's chain puts it.
+  if (!a.tilted_positions.empty()) {
+    const std::string tilt(1, a.tilt_axis);
+    if (parts::tiltAxisName(m) != tilt)
+      throw InputError(a.file, a.tilted_positions.front().line,
+                       "tilted_positions: tilt " + tilt + ", but " + m.file + " has " +
+                           (parts::tiltAxisName(m).empty() ? std::string("no tilting axis") : "a " + parts::tiltAxisName(m) + " axis"));
+    const parts::RotaryAxis& ax = tilt == "B" ? m.b : m.a;
+    const auto chain = parts::machineChain(m, std::nullopt, true);
+    const double th0 = degToRad(a.angle_at_c0_deg);
+    const Vector3d at_zero(m.c_axis_centre_mm.x() + a.radius_from_axis_mm * std::cos(th0),
+                           m.c_axis_centre_mm.y() + a.radius_from_axis_mm * std::sin(th0),
+                           m.table_surface_z_mm + a.centreHeightAboveTable());
+    for (const auto& tp : a.tilted_positions) {
+      const double steps = tp.tilt_deg / ax.resolution_deg, c_steps = tp.c_deg / m.c.resolution_deg;
+      if (std::fabs(steps - std::round(steps)) > 1e-6 || std::fabs(c_steps - std::round(c_steps)) > 1e-6)
+        throw InputError(a.file, tp.line, "tilted_positions: " + tilt + " " + formatNumber(tp.tilt_deg) + ", C " +
+                                              formatNumber(tp.c_deg) + " deg is not a multiple of the axes' resolution");
+      if (!ax.continuous && (tp.tilt_deg < ax.min_deg || tp.tilt_deg > ax.max_deg))
+        throw SafetyError(a.file + ":" + std::to_string(tp.line) + ": tilted_positions: " + tilt + " = " +
+                          formatNumber(tp.tilt_deg) + " deg is outside the " + tilt + " travel of " + m.file);
+      parts::ManifestSphere s;
+      s.position = static_cast<int>(man.spheres.size() + 1);
+      s.id = "S" + std::to_string(s.position);
+      s.c_deg = tp.c_deg;
+      s.tilt_deg = tp.tilt_deg;
+      s.angle_deg = wrapDeg360(a.angle_at_c0_deg + sense * s.c_deg);
+      geometry::ChainState st;
+      st.positions = {{tilt, tp.tilt_deg}, {"C", tp.c_deg}};
+      s.nominal_centre_mm = geometry::machineCoordinatesOf(chain, st, at_zero);
+      man.spheres.push_back(s);
+    }
+    parts::ManifestTiltAxis t;
+    t.name = tilt;
+    t.centre_mm = tilt == "B" ? *m.b_axis_centre_xz_mm : *m.a_axis_centre_yz_mm;
+    t.positive_is_clockwise = ax.positive_is_clockwise;
+    man.tilt_axis = t;
+  }
   // Seed 004 Eqs. 5.4-5.10 index k by the side of the C axis: the printed signs hold for
   // k = 1..4 at -X, +Y, +X, -Y (notes/seed004.md §2.3).
   const double formula_angle[4] = {180, 90, 0, 270};
   for (int f = 0; f < 4; ++f)
     for (auto& s : man.spheres)
-      if (s.repeat_of == 0 && sameAngle(s.angle_deg, formula_angle[f])) s.formula_index = f + 1;
+      if (s.repeat_of == 0 && s.tilt_deg == 0 && sameAngle(s.angle_deg, formula_angle[f])) s.formula_index = f + 1;
 
   // Probing directions: equator at machine angles 0, 360/n, ... from +X, then the top.
   std::vector<Vector3d> outward;
@@ -170,14 +221,13 @@ SpherePlan planSphereCycle(const SphereArtifact& a, const Machine& m, const Plan
   }
   if (a.top_point) outward.emplace_back(0, 0, 1);
 
-  const double z_centre = m.table_surface_z_mm + a.centreHeightAboveTable();
-  const double z_clear = z_centre + Rt + a.clearance_mm;
   const double tc_z = m.tool_change.z_mm;
 
   gcode::ProbeProgram& prog = plan.program;
   prog.title = "probeloop sphere-artifact cycle [seed 004 Ch. 5] - generated, do not edit";
   prog.work_offset = m.work_offset;
   prog.has_b_axis = m.b.present;
+  prog.has_a_axis = m.a.present;
   prog.log_file = files.log_file;
   prog.gap_s = a.gap_s;
   prog.live_interval = a.live_interval;
@@ -197,11 +247,30 @@ SpherePlan planSphereCycle(const SphereArtifact& a, const Machine& m, const Plan
   emit(tc_in, gcode::RapidMachineZ{tc_z}, "probe in");
   emit(tc_in, gcode::ToolChange{m.probe.tool, true}, "probe in");
 
+  const bool tilt_a = man.tilt_axis && man.tilt_axis->name == "A";
+  auto tiltOp = [&](double deg) -> gcode::Op { return tilt_a ? gcode::Op(gcode::RotateA{deg}) : gcode::Op(gcode::RotateB{deg}); };
+  double tilt_now = 0;
   for (const auto& s : man.spheres) {
-    const std::string pos = "position " + std::to_string(s.position) + " (C " + formatNumber(s.c_deg) + ")";
+    const std::string tilt = man.tilt_axis ? man.tilt_axis->name : "";
+    const std::string pos = "position " + std::to_string(s.position) + " (" +
+                            (s.tilt_deg != 0 ? tilt + " " + formatNumber(s.tilt_deg) + ", " : "") + "C " +
+                            formatNumber(s.c_deg) + ")";
+    const double z_clear_here = s.nominal_centre_mm.z() + Rt + a.clearance_mm;
     emit(body, gcode::Comment{pos + ", sphere " + s.id}, pos);
-    emit(body, gcode::Rapid{std::nullopt, std::nullopt, z_clear}, pos + ": clearance plane");
-    emit(body, gcode::RotateC{s.c_deg}, pos);
+    if (s.tilt_deg != 0 || tilt_now != 0) {
+      // A tilted table swings and turns only with the tool at the tool-change height, far
+      // above what it carries (on a tilted table C lifts the sphere as it turns); then the tip
+      // comes down above this position's sphere.
+      emit(body, gcode::RapidMachineZ{tc_z}, pos + ": up before the " + tilt + " and C axes move");
+      if (s.tilt_deg != tilt_now) emit(body, tiltOp(s.tilt_deg), pos);
+      emit(body, gcode::RotateC{s.c_deg}, pos);
+      emit(body, gcode::Rapid{s.nominal_centre_mm.x(), s.nominal_centre_mm.y(), std::nullopt}, pos + ": above the sphere");
+      emit(body, gcode::Rapid{std::nullopt, std::nullopt, z_clear_here}, pos + ": clearance plane");
+      tilt_now = s.tilt_deg;
+    } else {
+      emit(body, gcode::Rapid{std::nullopt, std::nullopt, z_clear_here}, pos + ": clearance plane");
+      emit(body, gcode::RotateC{s.c_deg}, pos);
+    }
     for (size_t j = 0; j < outward.size(); ++j) {
       const Vector3d& u = outward[j];
       const Vector3d c = s.nominal_centre_mm;
@@ -221,8 +290,12 @@ SpherePlan planSphereCycle(const SphereArtifact& a, const Machine& m, const Plan
       emit(body, gcode::ProbeMove{end.x(), end.y(), end.z(), a.probing_feed_mm_per_min, s.position, p.point},
            where, idx);
       emit(body, gcode::Rapid{start.x(), start.y(), start.z()}, where + ": retract");
-      emit(body, gcode::Rapid{std::nullopt, std::nullopt, z_clear}, where + ": clearance plane");
+      emit(body, gcode::Rapid{std::nullopt, std::nullopt, z_clear_here}, where + ": clearance plane");
     }
+  }
+  if (tilt_now != 0) {
+    emit(body, gcode::RapidMachineZ{tc_z}, "level the table: up before the swing");
+    emit(body, tiltOp(0), "level the table");
   }
   auto& tc_out = a.tool_change_each_cycle ? body : after;
   emit(tc_out, gcode::RapidMachineZ{tc_z}, "probe out");

@@ -5,7 +5,7 @@
 // - every line it writes to a log, right after writing it; every inputs sample, right after
 //   taking it (the link sees the data exactly when a live loop on a real machine could);
 // - before each block's motion (rapid, feed, probe, dwell) it asks for the axis offsets in
-//   effect now at the nominal tip position, and adds them to the commanded X Y Z as external
+//   effect now at the nominal tip position and B (a trunnion's offsets turn with B), and adds them to the commanded X Y Z as external
 //   offsets do (LinuxCNC eoffsets, a Fanuc work-offset shift): the reported probe positions
 //   stay in the program's frame, the real tip moves by the offset;
 // - a program that reads an externally written value (Fanuc common variable #500..#999 as a
@@ -23,7 +23,7 @@ class LiveLink {
   virtual void logLine(double t_s, const std::string& log_name, const std::string& line) = 0;
   // header: the inputs CSV's lines before the first row (given with every call; the same).
   virtual void inputSample(double t_s, const std::string& header, const std::string& row) = 0;
-  virtual Eigen::Vector3d offsetsUm(double t_s, const Eigen::Vector3d& tip_mm) = 0;
+  virtual Eigen::Vector3d offsetsUm(double t_s, const Eigen::Vector3d& tip_mm, double b_deg) = 0;
   virtual std::optional<double> externalVariable(double t_s, int n) = 0;
   virtual double analogInput(double t_s, int n) = 0;
 };

@@ -287,6 +287,12 @@ void VirtualMachine::cutMove(const MachinePosition& to, double F) {
       const Vector3d away_w(-lateral.x() / lateral.norm(), -lateral.y() / lateral.norm(), 0);
       const Vector3d away_m = workpieceDirToMachine(away_w);
       defl = away_w * (Fn * compliance(t, away_m));
+      if (!tr_.structure_units.empty()) {
+        // Seed 003's units turn and shift the tool under the force on it (machine frame ->
+        // workpiece frame: the inverse of the turn by C).
+        const Vector3d d = model::tcpDisplacement_mm(tr_.structure_units, Fn * away_m);
+        defl += Vector3d(d.dot(workpieceDirToMachine(Vector3d::UnitX())), d.dot(workpieceDirToMachine(Vector3d::UnitY())), d.z());
+      }
     }
   }
   // The cut is made warm; in the 20 °C frame the tool's radius shrinks with the part.
@@ -311,6 +317,11 @@ void VirtualMachine::cutMove(const MachinePosition& to, double F) {
                      {"radius_mm", r_w}, {"removed_mm3", rem.volume_mm3}, {"Ft_N", Ft}, {"Fn_N", Fn},
                      {"deflection_um", {defl.x() * 1e3, defl.y() * 1e3}},
                      {"tool_drift_um", {drift.x(), drift.y(), drift.z()}}});
+    if (!tr_.structure_units.empty()) {  // a turned unit also lifts or lowers the tool
+      cuts_.back()["p0_mm"][2] = w0.z() + defl.z();
+      cuts_.back()["p1_mm"][2] = w1.z() + defl.z();
+      cuts_.back()["deflection_um"] = {defl.x() * 1e3, defl.y() * 1e3, defl.z() * 1e3};
+    }
     if (tr_.axes.any || tr_.EC0Y_urad != 0 || tr_.EB0Z_urad != 0 || tr_.EA0Z_urad != 0 || scaleUmPerMm() != Vector3d::Zero()) {
       const Vector3d a0 = axesErrorUm(pos_.xyz_mm), a1 = axesErrorUm(to.xyz_mm);
       cuts_.back()["axes_um"] = {{a0.x(), a0.y(), a0.z()}, {a1.x(), a1.y(), a1.z()}};
@@ -364,6 +375,9 @@ void VirtualMachine::arcCut(const MachinePosition& to, double F_deg_per_min) {
         const Eigen::Vector2d radial_m = (q.head<2>() - m_.c_axis_centre_mm).normalized();
         away_m = Vector3d(sign * radial_m.x(), sign * radial_m.y(), 0);
         defl_mm = sign * Fn * compliance(t, away_m);
+        // Seed 003's units: the radial component of their displacement of the tip.
+        if (!tr_.structure_units.empty())
+          defl_mm += model::tcpDisplacement_mm(tr_.structure_units, Fn * away_m).dot(Vector3d(radial_m.x(), radial_m.y(), 0));
       }
     }
     const double r_w = r / (1.0 + partAlpha() * workpieceAbove20K());

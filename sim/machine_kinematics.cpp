@@ -10,6 +10,7 @@
 #include "core/csv.hpp"
 #include "core/error.hpp"
 #include "core/units.hpp"
+#include "geometry/kinematic_chain.hpp"
 #include "sim/virtual_machine_detail.hpp"
 
 namespace probeloop::sim::detail {
@@ -92,6 +93,39 @@ std::array<double, 7> VirtualMachine::locationErrors() const {
   return v;
 }
 
+std::array<double, 6> VirtualMachine::tiltLocationErrors() const {
+  auto v = tr_.static_errors.tilt_location;
+  if (tr_.thermal.present)
+    for (int i = 0; i < net_.size(); ++i)
+      for (int j = 0; j < 6; ++j) v[j] += tr_.thermal.per_node_K[i].tilt_location[j] * nodeRise(i);
+  return v;
+}
+
+Eigen::Isometry3d VirtualMachine::tiltTransform() const {
+  const auto e = tiltLocationErrors();
+  const bool on_a = m_.a.present;
+  const double q = on_a ? pos_.a_deg : pos_.b_deg;
+  const bool errors = std::any_of(e.begin(), e.end(), [](double v) { return v != 0; });
+  if (q == 0 && !errors) return Eigen::Isometry3d::Identity();
+  const auto& centre = on_a ? m_.a_axis_centre_yz_mm : m_.b_axis_centre_xz_mm;
+  if (!centre)
+    throw SafetyError(std::string("the table is tilted (") + (on_a ? "A " : "B ") + formatNumber(q) + " deg) but " + m_.file +
+                      " does not say where the " + (on_a ? "A axis lies (a_axis: centre_y" : "B axis lies (b_axis: centre_x") +
+                      ", centre_z)");
+  // The tilting axis's line with its location errors, as the evaluation's chain has it
+  // (ISO 230-7: the table turns about the displaced and tilted line; parts/machine_chain.hpp).
+  geometry::Joint j;
+  j.kind = geometry::JointKind::Rotary;
+  j.axis = on_a ? "A" : "B";
+  const parts::RotaryAxis& ax = on_a ? m_.a : m_.b;
+  j.direction = (on_a ? Vector3d::UnitX() : Vector3d::UnitY()) * (ax.positive_is_clockwise ? -1.0 : 1.0);
+  j.point_mm = on_a ? Vector3d(0, centre->x(), centre->y()) : Vector3d(centre->x(), 0, centre->y());
+  geometry::Twist t;
+  t.translation_mm = Vector3d(e[0], e[1], e[2]) * 1e-3;
+  t.rotation_rad = Vector3d(e[3], e[4], e[5]) * 1e-6;
+  return geometry::rotaryJointTransform(j, q, t);
+}
+
 double VirtualMachine::tipRadius() const {
   // A piece may name its own stylus (the stepped workpiece's d2 ball); else the machine's.
   if (tool_ == m_.probe.tool)
@@ -149,12 +183,30 @@ VirtualMachine::Artifact VirtualMachine::artifact() const {
   art.radius = a_->sphereRadius() * grow;
   art.stem_radius = a_->stem_diameter_mm / 2;
   art.table_z = m_.table_surface_z_mm;
+  art.table_point = Vector3d(m_.c_axis_centre_mm.x(), m_.c_axis_centre_mm.y(), m_.table_surface_z_mm);
+  const Eigen::Isometry3d tilt = tiltTransform();
+  if (!tilt.isApprox(Eigen::Isometry3d::Identity(), 0.0)) {
+    art.centre = tilt * art.centre;
+    art.table_point = tilt * art.table_point;
+    art.up = tilt.linear() * Vector3d::UnitZ();
+  }
   return art;
 }
 
 void VirtualMachine::checkStemAndTable(const Vector3d& a, const Vector3d& b, const Artifact& art,
                                        const std::string& what) const {
   const double r = tipRadius();
+  if (art.up != Vector3d::UnitZ()) {
+    // A tilted table: the stem along its normal, the tip above its plane.
+    const double h = (art.centre - art.table_point).dot(art.up);
+    if (segmentDistance(a, b, art.centre - h * art.up, art.centre - art.radius * art.up) < art.stem_radius + r - 1e-9)
+      throw SafetyError(what + " would hit the artifact's stem");
+    const double above = std::min((a - art.table_point).dot(art.up), (b - art.table_point).dot(art.up));
+    if (above - r < -1e-9)
+      throw SafetyError(what + " would hit the tilted table: tip " + formatNumber(above, 4) + " mm above its plane, radius " +
+                        formatNumber(r, 4) + " mm");
+    return;
+  }
   const Vector3d stem_top(art.centre.x(), art.centre.y(), art.centre.z() - art.radius);
   const Vector3d stem_bottom(art.centre.x(), art.centre.y(), art.table_z);
   if (segmentDistance(a, b, stem_bottom, stem_top) < art.stem_radius + r - 1e-9)

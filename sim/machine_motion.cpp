@@ -23,7 +23,7 @@ void VirtualMachine::atLine(int line) {
 void VirtualMachine::refreshOffsets() {
   if (!live_) return;
   const Vector3d tip = pos_.xyz_mm - Vector3d(0, 0, currentToolLength());
-  offset_mm_ = live_->offsetsUm(t_, tip) * 1e-3;
+  offset_mm_ = live_->offsetsUm(t_, tip, pos_.b_deg) * 1e-3;
 }
 
 void VirtualMachine::rapid(const MachinePosition& to) {

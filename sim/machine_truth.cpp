@@ -17,6 +17,8 @@ bool ErrorVector::any() const {
     if (v != 0) return true;
   for (double v : scale_um_per_mm)
     if (v != 0) return true;
+  for (double v : tilt_location)
+    if (v != 0) return true;
   return false;
 }
 
@@ -56,6 +58,13 @@ ErrorVector readErrorVector(YamlMap& m, const std::string& suffix) {
   for (int a = 0; a < 3; ++a) e.tool_um[a] = m.numberOr(std::string(tool[a]) + suffix, 0.0);
   const char* scale[] = {"EXX_um_per_mm", "EYY_um_per_mm", "EZZ_um_per_mm"};
   for (int a = 0; a < 3; ++a) e.scale_um_per_mm[a] = m.numberOr(std::string(scale[a]) + suffix, 0.0);
+  const char* comp[6] = {"X", "Y", "Z", "A", "B", "C"};
+  for (int k = 0; k < 6; ++k) {
+    const std::string unit = k < 3 ? "_um" : "_urad";
+    const std::string b = std::string("E") + comp[k] + "0B" + unit + suffix, a = std::string("E") + comp[k] + "0A" + unit + suffix;
+    if (m.has(b) && m.has(a)) m.fail(a, "the tilting axis is B or A, not both (" + b + " is given)");
+    e.tilt_location[static_cast<std::size_t>(k)] = m.numberOr(b, 0.0) + m.numberOr(a, 0.0);
+  }
   return e;
 }
 
@@ -164,6 +173,51 @@ void loadThermal(YamlMap t, ThermalTruth& th) {
     t.fail("nodes", e.what());
   }
   t.finish();
+}
+
+int axisIndex(const std::string& a) { return a == "x" ? 0 : a == "y" ? 1 : 2; }
+
+// A seed 003 structural unit (model/structural_stiffness.hpp) in the machine frame.
+model::StructuralUnit readStructuralUnit(YamlMap& u) {
+  model::StructuralUnit s;
+  s.name = u.stringOr("name", "unit");
+  const auto k = u.numberList("k_N_per_mm");
+  if (k.size() != 3) u.fail("k_N_per_mm", "expected [k_x, k_y, k_z] in N/mm (seed 003 Table 4)");
+  for (int i = 0; i < 3; ++i) {
+    if (!(k[i] >= 0)) u.fail("k_N_per_mm", "must not be negative (0: the unit takes no force in that direction)");
+    s.k_N_per_mm(i) = k[i];
+  }
+  if (u.has("shear")) {
+    const YAML::Node list = u.raw("shear");
+    if (!list.IsSequence()) u.fail("shear", "expected a list of directions, e.g. [x, y]");
+    for (const auto& item : list) {
+      const std::string a = item.IsScalar() ? item.as<std::string>() : "";
+      if (a != "x" && a != "y" && a != "z") u.fail("shear", "expected x, y or z, got '" + a + "'");
+      if (!(s.k_N_per_mm(axisIndex(a)) > 0)) u.fail("shear", "direction " + a + " needs a stiffness > 0 in k_N_per_mm");
+      s.shear[axisIndex(a)] = true;
+    }
+  }
+  if (u.has("moments"))
+    for (auto& m : u.mapList("moments")) {
+      model::MomentPath p;
+      p.force_axis = axisIndex(m.choice("force", {"x", "y", "z"}));
+      const std::string lever = m.choice("lever", {"+x", "-x", "+y", "-y", "+z", "-z"});
+      if (axisIndex(lever.substr(1)) == p.force_axis) m.fail("lever", "must be perpendicular to the force (no moment otherwise)");
+      p.lever = (lever[0] == '-' ? -1.0 : 1.0) * Eigen::Vector3d::Unit(axisIndex(lever.substr(1)));
+      p.R_mm = m.positiveQuantity("R", Dimension::Length);
+      p.S_mm = m.positiveQuantity("spacing", Dimension::Length);
+      if (!(s.k_N_per_mm(p.force_axis) > 0)) m.fail("force", "the unit's stiffness in this direction must be > 0");
+      p.eq = "seed 003 eq. 29";
+      m.finish();
+      s.moments.push_back(p);
+    }
+  if (u.has("arm_mm")) {
+    const auto a = u.numberList("arm_mm");
+    if (a.size() != 3) u.fail("arm_mm", "expected [x, y, z] in mm (the unit's pivot -> the tool tip)");
+    s.arm_mm = Eigen::Vector3d(a[0], a[1], a[2]);
+  }
+  u.finish();
+  return s;
 }
 
 }  // namespace
@@ -287,6 +341,8 @@ MachineTruth loadMachineTruth(const std::string& path) {
       t.lost_motion_um_per_m_per_min(k) = st->numberOr(lost[k], 0);
       if (!(t.lost_motion_um_per_m_per_min(k) >= 0)) st->fail(lost[k], "must not be negative (0 = none)");
     }
+    if (st->has("units"))
+      for (auto& u : st->mapList("units")) t.structure_units.push_back(readStructuralUnit(u));
     t.lost_motion_max_um = st->numberOr("lost_motion_max_um", 0);
     if (t.lost_motion_um_per_m_per_min != Eigen::Vector3d::Zero() && !(t.lost_motion_max_um > 0))
       st->fail("lost_motion_max_um", "must be given and positive with a lost motion (a rapid would otherwise wind a drive up without bound)");

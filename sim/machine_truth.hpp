@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "geometry/location_errors.hpp"
+#include "model/structural_stiffness.hpp"
 #include "sim/rigid_campaign.hpp"
 #include "sim/thermal_network.hpp"
 
@@ -30,6 +31,10 @@ struct ErrorVector {
   // (um per mm of travel; a heated ball screw stretches its axis's scale: seed 000's thermal
   // position error e_pt, which grows with the distance).
   std::array<double, 3> scale_um_per_mm{};  // EXX_um_per_mm, EYY_um_per_mm, EZZ_um_per_mm
+  // Location errors of the tilting axis (B or A, issue 33), right-hand about +X +Y +Z as
+  // ISO 230-7 counts them, at its axis line: EX0B_um, EY0B_um, EZ0B_um, EA0B_urad, EB0B_urad,
+  // EC0B_urad (or the same with A). The table with C and the artifact rides on it.
+  std::array<double, 6> tilt_location{};
   bool any() const;
 };
 
@@ -132,6 +137,10 @@ struct MachineTruth {
   // Static stiffness of the structure at the tool (seed 003: F/k), N/um per machine axis;
   // 0 = rigid.
   Eigen::Vector3d stiffness_N_per_um = Eigen::Vector3d::Zero();
+  // Seed 003's structural units (crossbeam, bed) in the machine frame: under the force on the
+  // tool each translates by F/(4k) and turns by F R/(k S^2), and the tip moves by
+  // delta + eps x arm (model/structural_stiffness.hpp); added to the F/k above. Empty = none.
+  std::vector<model::StructuralUnit> structure_units;
   // Speed-dependent lost motion of each drive (um per m/min of the axis's last speed, capped
   // at lost_motion_max_um): a semi-closed-loop drive's screw and nut wound up by friction
   // while the axis moved, held by stiction when it stops; the tip lags the command against

@@ -171,6 +171,59 @@ TEST(Machining, ForceDeflectionLeavesTheWallProud) {
   EXPECT_NEAR(r.cmm[4].z(), 38, kCmmDigit);
 }
 
+// Seed 003's structure (docs/seed003-stiffness.md): a unit with the crossbeam's stiffness,
+// shear in X and Y, the X force's moment on a 40 mm lever (-Z) over supports 100 mm apart,
+// the tip at (10, 0, -40) mm from its pivot. Pushed +X by F_n, the tool moves by
+// F_n/(4 k_x) + theta x 40 mm along X and theta x 10 mm along Z, theta = F_n 40/(k_x 100^2)
+// (eqs. 30, 31; the arithmetic here, not model/structural_stiffness).
+TEST(Machining, Seed003StructureTurnsTheToolUnderTheCuttingForce) {
+  const auto w = block(0.4);
+  const auto r = machine(truthFrom(R"(
+structure:
+  units:
+    - name: crossbeam
+      k_N_per_mm: [4679, 4926, 142857]
+      shear: [x, y]
+      moments: [{force: x, lever: -z, R: 40 mm, spacing: 100 mm}]
+      arm_mm: [10, 0, -40]
+)"), w);
+  const double L1 = 25, L2 = 40, E = 600e3, I = M_PI * std::pow(10.0, 4) / 64;
+  const double c_tool = (std::pow(L1, 3) / 3 + L1 * (L2 - L1) * (L2 + L1) / 6 + L2 * (L2 - L1) * (2 * L2 + L1) / 6) / (E * I);
+  const nlohmann::json* full = nullptr;
+  for (const auto& c : r.cuts)
+    if (std::fabs(c["p0_mm"][1].get<double>() + 30) < 1e-6 && std::fabs(c["p1_mm"][1].get<double>() - 30) < 1e-6) full = &c;
+  ASSERT_NE(full, nullptr);
+  const double Fn = (*full)["Fn_N"];
+  ASSERT_GT(Fn, 20);  // about 25 N (the test above pins the force)
+  const double theta = Fn * 40 / (4679.0 * 100 * 100);
+  const double dx = Fn * c_tool + Fn / (4 * 4679.0) + theta * 40, dz = theta * 10;
+  ASSERT_EQ((*full)["deflection_um"].size(), 3u);
+  EXPECT_NEAR((*full)["deflection_um"][0].get<double>(), dx * 1e3, 1e-9);
+  EXPECT_NEAR((*full)["deflection_um"][1].get<double>(), 0, 1e-12);
+  EXPECT_NEAR((*full)["deflection_um"][2].get<double>(), dz * 1e3, 1e-9);
+  EXPECT_GT(theta * 40, 0.5 * Fn / (4 * 4679.0));  // the rotation term is of the shear's size
+  for (int i = 9; i < 15; ++i) EXPECT_NEAR(r.cmm[i].x(), 35 + dx, kCmmDigit) << i;
+  // A lever along its own force has no moment: refused with the file's line.
+  EXPECT_THROW(truthFrom("structure:\n  units:\n    - {k_N_per_mm: [1, 1, 1], moments: [{force: x, lever: +x, R: 1 mm, spacing: 1 mm}]}\n"),
+               InputError);
+}
+
+// examples/truth_gantry_seed003.yaml is seed003Gantry() in the machine's frame (Y and Z of the
+// thesis swapped): for any force the tip moves as in the thesis's frame, relabelled (the swap
+// is a reflection; eps = l x F and eps x arm each flip, so the displacement does not).
+TEST(Machining, TheGantryTruthIsTheThesisGantry) {
+  const auto truth = loadMachineTruth(src("examples/truth_gantry_seed003.yaml"));
+  ASSERT_EQ(truth.structure_units.size(), 2u);
+  const auto thesis = probeloop::model::seed003Gantry();
+  for (const Vector3d F_t : {Vector3d(100, 0, 0), Vector3d(0, 100, 0), Vector3d(0, 0, 100), Vector3d(100, 100, 100), Vector3d(-30, 70, 10)}) {
+    const Vector3d d_t = probeloop::model::tcpDisplacement_mm(thesis, F_t);
+    const Vector3d d_m = probeloop::model::tcpDisplacement_mm(truth.structure_units, Vector3d(F_t.x(), F_t.z(), F_t.y()));
+    EXPECT_NEAR(d_m.x(), d_t.x(), 1e-15) << F_t.transpose();
+    EXPECT_NEAR(d_m.y(), d_t.z(), 1e-15) << F_t.transpose();
+    EXPECT_NEAR(d_m.z(), d_t.y(), 1e-15) << F_t.transpose();
+  }
+}
+
 // Cut warm, measured at 20 °C: the workpiece shrinks about its datum (bottom centre).
 TEST(Machining, AWarmWorkpieceShrinksOnTheCmm) {
   const auto r = machine(truthFrom(R"(

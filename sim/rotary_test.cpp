@@ -162,6 +162,32 @@ TEST(RotaryCut, TheRadialForcePushesTheToolOutward) {
   for (double radius : cmmRadii(out)) EXPECT_NEAR(radius, 48 + defl_mm, kCmmRadius);
 }
 
+// Seed 003's structure on an arc cut (docs/seed003-stiffness.md): the radial component of
+// the unit's tip displacement under F_n along +X joins the tool's: F_n/(4 k_x) + theta 40 mm,
+// theta = F_n 40/(k_x 100^2) (eqs. 30, 31, by hand here).
+TEST(RotaryCut, Seed003StructureAddsItsRadialDisplacement) {
+  const auto w = cylinder(0.4);
+  const std::string prog = kHead + "S8000 M3\nG0 X53 Y0 Z50\nG1 Z35 F300\nG1 C360 F3600\nG0 Z50\nM5\nM2\n";
+  const auto out = run(prog, w, truthFrom(R"(
+structure:
+  units:
+    - {name: crossbeam, k_N_per_mm: [4679, 4926, 142857], shear: [x, y], arm_mm: [0, 5, -40],
+       moments: [{force: x, lever: -z, R: 40 mm, spacing: 100 mm}]}
+)"), ring(48, -2, 10, 40, 9));
+  const auto cuts = nlohmann::json::parse(out.cuts_json);
+  const nlohmann::json* arc = nullptr;
+  for (const auto& c : cuts)
+    if (c.contains("kind") && c["kind"] == "arc") arc = &c;
+  ASSERT_NE(arc, nullptr);
+  const double Fn = (*arc)["Fn_N"].get<double>();
+  ASSERT_GT(Fn, 1);
+  const double L1 = 25, L2 = 40, E = 600e3, I = kPi * std::pow(10.0, 4) / 64;
+  const double c_tool = (std::pow(L1, 3) / 3 + L1 * (L2 - L1) * (L2 + L1) / 6 + L2 * (L2 - L1) * (2 * L2 + L1) / 6) / (E * I);
+  const double defl_mm = Fn * (c_tool + 1 / (4 * 4679.0) + 40.0 * 40 / (4679.0 * 100 * 100));
+  EXPECT_NEAR((*arc)["radial_deflection_um"].get<double>(), defl_mm * 1e3, 1e-9);
+  for (double radius : cmmRadii(out)) EXPECT_NEAR(radius, 48 + defl_mm, kCmmRadius);
+}
+
 void expectRefusal(const std::function<void()>& f, const std::string& want) {
   try {
     f();

@@ -128,6 +128,9 @@ class VirtualMachine : public gcode::MachineInterface {
     double table_z = 0;
     double dT = 0;
     std::array<double, 7> location{};
+    // The table's normal and a point of its surface (tilted with A or B; else +Z at table_z).
+    Vector3d up = Vector3d::UnitZ();
+    Vector3d table_point = Vector3d::Zero();
   };
 
   // --- moves and logs (machine_motion.cpp) ------------------------------------------------
@@ -166,6 +169,10 @@ class VirtualMachine : public gcode::MachineInterface {
   void noteAxesMotion(const Vector3d& to, double dt_s);
   Vector3d scaleUmPerMm() const;
   std::array<double, 7> locationErrors() const;
+  std::array<double, 6> tiltLocationErrors() const;
+  // Where the tilting axis (with its location errors) takes a point of the level table;
+  // the identity without a tilt and without tilt errors.
+  Eigen::Isometry3d tiltTransform() const;
   double currentToolLength() const { return toolLength(tool_); }
   double tipRadius() const;
   const parts::CuttingTool* cutter() const { return w_ ? w_->tool(tool_) : nullptr; }

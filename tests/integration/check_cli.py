@@ -32,7 +32,7 @@ from unsafe_edits import (first, off_travel, rapid_through_sphere, no_contact_ch
 PL = os.environ["PROBELOOP"]
 SRC = os.environ["PROBELOOP_SOURCE_DIR"]
 W = tempfile.mkdtemp(prefix="probeloop-check-")
-MACHINES = {m: f"{SRC}/parts/machines/{m}.yaml" for m in ("nmv5000", "linuxcnc_rotary_mill", "vmc3")}
+MACHINES = {m: f"{SRC}/parts/machines/{m}.yaml" for m in ("nmv5000", "linuxcnc_rotary_mill", "vmc3", "gantry_seed003")}
 PIECES = {"sphere": f"{SRC}/parts/sphere_artifact.yaml", "ttp": f"{SRC}/parts/thermal_test_piece.yaml",
           "sw": f"{SRC}/parts/stepped_workpiece.yaml"}
 check = Checks()
@@ -65,6 +65,10 @@ for machine in ("vmc3", "nmv5000", "linuxcnc_rotary_mill"):
     for dialect in ("linuxcnc", "fanuc"):
         for k in ((2, 8) if os.environ.get("CHECK_QUICK") == "1" else range(1, 9)):
             plans.append(("sw", machine, dialect, f"W{k}"))
+# seed 003's gantry (X, Y, Z all on the tool side): the stepped workpiece's first and last experiments
+for dialect in ("linuxcnc", "fanuc"):
+    for k in (2, 8):
+        plans.append(("sw", "gantry_seed003", dialect, f"W{k}"))
 dirs = {}
 for piece, machine, dialect, exp in plans:
     out = f"{W}/{piece}_{machine}_{dialect}" + (f"_{exp}" if exp else "")
