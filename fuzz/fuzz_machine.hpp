@@ -34,6 +34,7 @@ class FuzzMachine : public gcode::MachineInterface {
     if (out.contact) {
       // 0.5 a + 0.5 b: finite for any finite a and b (a + b may overflow).
       out.stop.xyz_mm = 0.5 * at_.xyz_mm + 0.5 * to.xyz_mm;
+      out.stop.a_deg = 0.5 * at_.a_deg + 0.5 * to.a_deg;
       out.stop.b_deg = 0.5 * at_.b_deg + 0.5 * to.b_deg;
       out.stop.c_deg = 0.5 * at_.c_deg + 0.5 * to.c_deg;
     }
@@ -55,7 +56,7 @@ class FuzzMachine : public gcode::MachineInterface {
 
  private:
   static void requireFinite(const gcode::MachinePosition& to) {
-    if (to.xyz_mm.allFinite() && std::isfinite(to.b_deg) && std::isfinite(to.c_deg)) return;
+    if (to.xyz_mm.allFinite() && std::isfinite(to.a_deg) && std::isfinite(to.b_deg) && std::isfinite(to.c_deg)) return;
     std::fprintf(stderr, "fuzz machine: the interpreter handed a non-finite coordinate to the machine\n");
     std::abort();
   }
