@@ -10,7 +10,8 @@ without an ABORT, makes two probe moves per planned point and cycle, each measur
 the manifest's contact + overtravel along the approach with A/B/C at the position's angles,
 logs one PT line per point, and every move of A, B or C happens with the tip at or above the
 clearance plane of the highest tilted sphere (the program goes up before the rotary axes move).
-About 5 s.
+The trunnion's program edited to swing B over a lowered probe is refused by `check` at the B
+line. About 5 s.
 
 Needs $PROBELOOP, $PROBELOOP_SOURCE_DIR and rs274 (scripts/setup.sh installs it).
 """
@@ -103,6 +104,31 @@ def rs274_check(label, folder, axis, art):
           tilting >= 6 and not low, low[:3])
 
 
+def swing_edit(folder, machine, art):
+    """The retract before position 7's tilt (B +30 -> -30 at C 90) replaced by a move to X0 Y160,
+    where the sphere's centre passes at B 0 (Z 75; at B = q it is at X -75 sin q, Z 75 cos q).
+    With the tip at Z94 the swing brings the sphere within 2 mm of the tip (radii 15 + 3 plus the
+    margin: 20 mm between centres) at cos q = 14061/14100, q = 4.26 deg: check refuses the B
+    line with tilt-swing. With the tip at Z100 (7 mm clear at B 0) the B line passes."""
+    lines = open(f"{folder}/sphere_cycle.ngc").read().split("\n")
+    i = next(k for k, l in enumerate(lines) if l.startswith("(position 7 [B -30, C 90]"))
+    assert lines[i + 1].startswith("G53 G0 Z") and lines[i + 2] == "G0 B-30.000", lines[i:i + 3]
+    for z, refused in (("94", True), ("100", False)):
+        lines[i + 1] = f"G0 X0.0000 Y160.0000 Z{z}.0000"
+        path = f"{folder}/swing_edit.ngc"
+        open(path, "w").write("\n".join(lines))
+        code, out = run("check", path, "--machine", machine, "--part", art)
+        at = f"swing_edit.ngc:{i + 3}: tilt-swing: "
+        if refused:
+            m = re.search(re.escape(at) + r"B moves from 30.000 to -30.000 deg: the table swings the sphere of the artifact "
+                          r"within [0-9.]+ mm of the probe's stylus tip at B ([-0-9.]+) deg", out)
+            check("an emitted program edited to swing B over a probe lowered to Z94: check refuses the B line "
+                  "(tilt-swing at B 4.26 deg, derived)", code == 3 and m is not None and abs(float(m.group(1)) - 4.26) < 0.05,
+                  out[-1500:])
+        else:
+            check("... with the probe at Z100 the B line passes", at not in out, out[-1500:])
+
+
 try:
     machines = [("B/C trunnion (LinuxCNC)", f"{SRC}/parts/machines/linuxcnc_trunnion_bc.yaml", ART_BC, "B", []),
                 ("NMV 5000 in the LinuxCNC dialect", f"{SRC}/parts/machines/nmv5000.yaml", ART_BC, "B",
@@ -118,6 +144,8 @@ try:
             continue
         code, out = run("check", f"{folder}/sphere_cycle.ngc", "--machine", machine, "--part", art)
         check(f"{label}: probeloop check finds nothing", code == 0, out[-1500:])
+        if n == 0:
+            swing_edit(folder, machine, art)
         if shutil.which("rs274") is None:
             check("rs274 is installed (scripts/setup.sh)", False)
             continue
