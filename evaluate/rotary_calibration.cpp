@@ -234,11 +234,14 @@ std::string rotaryIdentifiabilityText(const parts::PlanManifest& m) {
     return out.empty() ? std::string("none") : out;
   };
   s << "Rotary axes (" << m.tilt_axis->name << " and C), identifiability of the planned positions (sensitivity rank):\n";
-  s << "  drift since cycle 1: rank " << r.relative.rank << " of " << r.relative.names.size() << "; identifies "
-    << list(r.relative, true) << "; cannot identify " << list(r.relative, false) << "\n";
+  auto verdict = [&](const geometry::Identifiability& id) {
+    return id.all() ? "; identifies every one: " + list(id, true)
+                    : "; identifies " + list(id, true) + "; cannot identify " + list(id, false);
+  };
+  s << "  drift since cycle 1: rank " << r.relative.rank << " of " << r.relative.names.size() << verdict(r.relative) << "\n";
   for (const auto& t : r.relative.sentences()) s << "    " << t << "\n";
   s << "  absolute (with the sphere's placement): rank " << r.absolute.rank << " of " << r.absolute.names.size()
-    << "; identifies " << list(r.absolute, true) << "; cannot identify " << list(r.absolute, false) << "\n";
+    << verdict(r.absolute) << "\n";
   for (const auto& t : r.absolute.sentences()) s << "    " << t << "\n";
   s << "  the " << m.tilt_axis->name << " axis's own zero (" << r.with_tilt_zero.names.back()
     << ") is not calibrated: sphere centres cannot tell it from a tilt and a shift of C";
