@@ -26,7 +26,7 @@ inline KinematicChain trunnion(const Trunnion& t) {
   const Eigen::Vector3d b_point(t.b_axis_xz_mm.x(), 0, t.b_axis_xz_mm.y());
   const Eigen::Vector3d c_point(t.c_axis_xy_mm.x(), t.c_axis_xy_mm.y(), t.pivot_z_mm);
   c.workpiece_branch = {Body{"B trunnion", Eigen::Vector3d::Zero(), {JointKind::Rotary, "B", t.b_sense * Eigen::Vector3d::UnitY(), b_point}},
-                        Body{"C table", Eigen::Vector3d::Zero(), {JointKind::Rotary, "C", -Eigen::Vector3d::UnitZ(), c_point}}};
+                        Body{"C table", Eigen::Vector3d::Zero(), {JointKind::Rotary, "C", -Eigen::Vector3d::UnitZ(), c_point, LocationConvention::BodyOnAxis}}};
   const char* n[3] = {"X", "Y", "Z"};
   for (int k = 0; k < 3; ++k)
     c.tool_branch.push_back(Body{n[k], Eigen::Vector3d::Zero(), {JointKind::Linear, n[k], Eigen::Vector3d::Unit(k), Eigen::Vector3d::Zero()}});

@@ -221,7 +221,7 @@ void VirtualMachine::checkPath(const MachinePosition& to, const std::string& wha
   if (w_) return checkWorkpiecePath(to, what);
   if (!a_) return;
   const Artifact art = artifact();
-  if (to.c_deg != pos_.c_deg || to.b_deg != pos_.b_deg) {
+  if (to.c_deg != pos_.c_deg || to.b_deg != pos_.b_deg || to.a_deg != pos_.a_deg) {
     // The table turns under a still tip: it must be clear of the sphere's circle.
     const Vector3d tip = tipActual(pos_.xyz_mm);
     if (tip.z() - tipRadius() < art.centre.z() + art.radius + 1e-9) {
