@@ -28,7 +28,7 @@ check = Checks()
 
 readme = open(f"{SRC}/README.md").read()
 blocks = re.findall(r"<!-- tutorial: (\w+) -->\s*```sh\n(.*?)```", readme, re.S)
-check("the README has the four tutorial blocks", [n for n, _ in blocks] == ["sphere", "model", "ttp", "stepped"],
+check("the README has the five tutorial blocks", [n for n, _ in blocks] == ["sphere", "model", "ttp", "stepped", "rotary"],
       [n for n, _ in blocks])
 for d in ("parts", "examples"):
     os.symlink(f"{SRC}/{d}", f"{W}/{d}")
