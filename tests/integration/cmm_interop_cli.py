@@ -92,6 +92,20 @@ if code == 0:
         a, b = numbers(f"{T}/ev-csv/errors.csv"), numbers(f"{T}/ev-qif/errors.csv")
         check(f"the QIF route gives the CSV route's errors.csv, every printed digit ({len(a) - 1} cycles)", a == b and len(a) > 2,
               next((f"{x.strip()} | {y.strip()}" for x, y in zip(a, b) if x != y), "row count"))
+        # A vendor's extension in the results (issue 34): read with a warning at its line, the same
+        # errors.csv; refused under --strict.
+        qif = open(f"{T}/run/cmm_results.qif").read()
+        at = qif.index("</MeasurementResults>")
+        ext_line = qif[:at].count("\n") + 1
+        open(f"{W}/vendor.qif", "w").write(qif[:at] + '<v:Probe xmlns:v="urn:vendor">T1</v:Probe>' + qif[at:])
+        c4, out4, e4 = run("evaluate", f"{W}/vendor.qif", "--manifest", f"{T}/plan/plan.json", "--out", f"{T}/ev-vendor")
+        check(f"evaluate: a vendor extension is warned at line {ext_line} in stdout, the same errors.csv",
+              c4 == 0 and any(l.startswith(f"warning: {W}/vendor.qif:{ext_line}: MeasurementResults: unknown extension Probe")
+                              for l in out4.split("\n"))
+              and numbers(f"{T}/ev-vendor/errors.csv") == a, out4[-600:] + e4)
+        c5, _, e5 = run("evaluate", f"{W}/vendor.qif", "--manifest", f"{T}/plan/plan.json", "--out", f"{T}/ev-strict", "--strict")
+        check("evaluate --strict: refused at that line, nothing written", c5 != 0 and f"vendor.qif:{ext_line}: MeasurementResults: unknown "
+              "extension Probe" in e5 and not os.path.exists(f"{T}/ev-strict/errors.csv"), e5)
         # The evaluation's own results.qif: valid, and its characteristics are errors.csv's values.
         ok, e = valid(f"{T}/ev-qif/results.qif")
         check("the evaluation's results.qif validates against the QIF 3.0 XSD", ok, e)
