@@ -144,6 +144,14 @@ if code == 0:
     if code == 0:
         c3, out3, e3 = run("evaluate", f"{T}/run-dmis/cmm_results.dmo", "--manifest", f"{T}/plan/plan.json", "--out", f"{T}/ev-dmis")
         check("evaluate the DMIS output", c3 == 0 and "assigned by labels" in out3, e3)
+        # fit on an exchange file (issue 34): feature TOP's 12 points from the DMIS output, from the
+        # QIF results of the same run and from cmm_export.csv's TOP rows give one plane.
+        fits = []
+        for f in (f"{T}/run-dmis/cmm_results.dmo", f"{T}/run-dmis/cmm_results.qif", f"{T}/run-dmis/cmm_export.csv"):
+            cf, of, ef = run("fit", "plane", f, "--feature", "TOP", "--json")
+            fits.append({q["name"]: q["value"] for q in json.loads(of)["parameters"]} if cf == 0 else ef)
+        check("fit plane --feature TOP: the DMIS output, the QIF results and the CSV export give one plane (1e-4 mm)",
+              all(isinstance(x, dict) for x in fits) and all(abs(fits[i][k] - fits[2][k]) < 1e-4 for i in (0, 1) for k in fits[2]), fits)
         if c3 == 0 and c1 == 0:
             a, b = numbers(f"{T}/ev-csv/errors.csv"), numbers(f"{T}/ev-dmis/errors.csv")
             check(f"the DMIS route gives the CSV route's errors.csv, every printed digit ({len(a) - 1} cycles)", a == b and len(a) > 2,
