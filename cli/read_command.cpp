@@ -29,7 +29,8 @@ int runRead(const ReadArgs& a) {
   }
   if (interop::looksLikeDmis(text)) {  // a program (DMISMN: its nominals and PTMEAS points) or output (FILNAM)
     const bool program = interop::isDmisProgram(text);
-    const auto d = program ? interop::parseDmisProgram(text, a.file) : interop::parseDmisOutput(text, a.file);
+    const auto d = program ? interop::parseDmisProgram(text, a.file)
+                           : interop::parseDmisOutput(text, a.file, interop::CmmReadOptions{a.strict});
     std::fputs((a.json ? interop::cmmDocumentJson(d) : interop::cmmDocumentText(d)).c_str(), stdout);
     return 0;
   }

@@ -11,7 +11,7 @@ namespace probeloop::evaluate {
 
 void readCmmExchange(PointCloud& pc, const std::string& text, const PointSelection& select) {
   const interop::CmmReadOptions options{select.strict};
-  const auto d = pc.format == "qif" ? interop::parseQifResults(text, pc.file, options) : interop::parseDmisOutput(text, pc.file);
+  const auto d = pc.format == "qif" ? interop::parseQifResults(text, pc.file, options) : interop::parseDmisOutput(text, pc.file, options);
   for (const auto& w : d.warnings) pc.warnings.push_back(pc.file + ":" + std::to_string(w.line) + ": " + w.what);
   // Features with points, by name (a name measured in several runs counts once per run).
   std::vector<const interop::CmmFeature*> with_points;

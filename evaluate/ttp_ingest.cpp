@@ -270,7 +270,8 @@ TtpPoints cmmPointsFromRows(const std::string& path, const std::string& format, 
 // A QIF 3.0 Results document or a DMIS output file: every measured feature's points, labelled
 // by its name, numbered in their order (the line: the feature measurement's).
 TtpPoints cmmResults(const std::string& path, const std::string& text, const parts::PlanManifest& m, bool qif, bool strict) {
-  const auto d = qif ? interop::parseQifResults(text, path, interop::CmmReadOptions{strict}) : interop::parseDmisOutput(text, path);
+  const interop::CmmReadOptions options{strict};
+  const auto d = qif ? interop::parseQifResults(text, path, options) : interop::parseDmisOutput(text, path, options);
   if (d.runs > 1)
     throw InputError(path, 0, std::to_string(d.runs) + " MeasurementResults (runs) in one file: evaluate reads one part's "
                                                       "measurement; write each run to its own file");
