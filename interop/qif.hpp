@@ -21,10 +21,10 @@
 // element by the declared units). A document with no FileUnits is read in mm, with a note.
 // Characteristic measurements with a Value are returned by their item's name.
 // Contract: InputError with file:line for what is not QIF 3 (another root, namespace or
-// versionQIF), a point set whose Points do not hold 3 x count numbers, a reference to a point
-// set that is not there, a number that does not parse, an unknown length unit; binary point
-// sets (BinaryPoints) are refused with the reason. Nothing is guessed silently: what is passed
-// over is listed in notes.
+// versionQIF), a point set whose Points do not hold 3 x count numbers (of a set a feature
+// reads), a number that does not parse, an unknown length unit; binary point sets
+// (BinaryPoints) are refused with the reason. Nothing is guessed silently: what is passed over
+// is listed in notes, what is read despite a producer's mistake in warnings.
 // Lenient (docs/interop.md#lenient-reading): what a producer got wrong without changing the
 // meaning is read with a warning in the document's warnings (its line, what was done):
 // elements out of the XSD's order (MeasurementResults, feature measurements), a PointList id
