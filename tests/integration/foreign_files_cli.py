@@ -185,4 +185,18 @@ rc, out, err = run("fit", "cylinder", CM)
 check("fit without --feature: refused, naming the features with points", rc != 0 and "give --feature NAME" in err and "CYL_1" in err, err)
 rc, out, err = run("fit", "cylinder", CM, "--feature", "NOPE")
 check("fit --feature NOPE: refused, listing the names", rc != 0 and "no feature named 'NOPE'" in err and "CYL_1" in err, err)
+
+# The DMSC's demoQIFout.py file: measured features only, no points.
+PY = os.path.join(SRC, "tests", "data", "foreign", "qif", "testPython30.qif")
+py = open(PY, encoding="utf-8").read()
+meas = re.findall(r"<(\w+)FeatureMeasurement id=", py)
+dias = [float(x) for x in re.findall(r"<Diameter>([0-9.]+)</Diameter>", py.split("<Results>")[1])]
+rc, js, err = run("read", PY, "--json")
+d = json.loads(js) if rc == 0 else {}
+got = [(f["kind"], f.get("measured", {}).get("diameter_mm")) for f in d.get("features", [])]
+check(f"testPython30: {len(meas)} measured features ({', '.join(meas)}; diameters {dias} from the text), no points, no warning",
+      rc == 0 and [k for k, _ in got] == [m.lower() for m in meas] and [x for _, x in got if x is not None] == dias
+      and all(not f["points_mm"] for f in d["features"]) and d["warnings"] == [] and "point_sets" not in d, (got, err))
+rc, out, err = run("fit", "cylinder", PY, "--feature", "DAT_B")
+check("testPython30: fit refuses a file without points", rc != 0 and f"no measured features with points in the file ({len(meas)} features)" in err, err)
 check.finish()
