@@ -13,6 +13,8 @@ of tests/data/foreign (README.md there has each file's provenance):
   1e-6 mm / 1e-6; with the file's ProbeRadius compensated (a bore: --material outside) the
   diameter agrees with CheckMate's own measured 30.11094 mm within 1 um, and its axis with
   CheckMate's direction within 0.1 mrad; the warnings reach fit's output (text and --json).
+- the DMSC's demoQIFout.py results (features only): read with its four features and their
+  diameters (from the file's text), no points, no warning; `fit` refuses it for want of points.
 
 Needs $PROBELOOP and $PROBELOOP_SOURCE_DIR."""
 import json, math, os, re, subprocess, sys
