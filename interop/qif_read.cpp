@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -166,6 +167,8 @@ struct PointSets {
   std::map<std::string, const xmlNode*> byId;
   std::vector<const xmlNode*> inOrder;
   std::set<std::string> referenced;
+  // Parsed once per set (null: unreadable), so that many broken references cost no more than one.
+  mutable std::map<const xmlNode*, std::optional<std::vector<CmmPoint>>> parsed;
 
   // The only unreferenced set whose every point lies on the feature's measured geometry within
   // the set's probe radius (points may be uncompensated tip centres) + 0.05 mm; null when none
@@ -176,18 +179,30 @@ struct PointSets {
     if (!f.measured.given) return nullptr;
     for (const auto* ps : inOrder) {
       if (referenced.count(attribute(ps, "id"))) continue;
-      try {
-        const auto pts = setPoints(r, ps);
-        double tol = 0.05;
-        if (const auto* pr = child(ps, "ProbeRadius")) tol += r.lengthOf(pr);
-        bool on = !pts.empty();
-        for (const auto& p : pts) {
-          const double off = offGeometry(f, p.p_mm);
-          on = on && std::isfinite(off) && off <= tol;
+      if (!parsed.count(ps)) {
+        try {
+          parsed[ps] = setPoints(r, ps);
+        } catch (const InputError&) {  // a set that cannot be read is no candidate
+          parsed[ps] = std::nullopt;
         }
-        if (on) ++fitting, found = ps;
-      } catch (const InputError&) {  // a set that cannot be read is no candidate
       }
+      const auto& pts = parsed[ps];
+      if (!pts || pts->empty()) continue;
+      double tol = 0.05;
+      try {
+        if (const auto* pr = child(ps, "ProbeRadius")) tol += r.lengthOf(pr);
+      } catch (const InputError&) {
+        continue;
+      }
+      bool on = true;
+      for (const auto& p : *pts) {
+        const double off = offGeometry(f, p.p_mm);
+        if (!(std::isfinite(off) && off <= tol)) {
+          on = false;
+          break;
+        }
+      }
+      if (on) ++fitting, found = ps;
     }
     return fitting == 1 ? found : nullptr;
   }
@@ -285,7 +300,7 @@ CmmDocument parseQifResults(const std::string& xml, const std::string& file_name
             if (const auto* ie = child(dn, "InternalExternal")) f.internal = text(ie) == "INTERNAL";
           }
       }
-        const auto* list = child(m, "PointList");
+      const auto* list = child(m, "PointList");
       for (const auto* ref : children(list)) {
         const std::string rt = local(ref), id = text(ref);
         if (rt != "WholePointSetId" && rt != "RangePointSetId" && rt != "SinglePointSetId")
