@@ -21,7 +21,7 @@ namespace {
 
 struct EvaluateArgs {
   std::string points, manifest, out = ".", format = "auto", scene, compare_with, probe_log, cycle_starts;
-  bool free_radius = false;
+  bool free_radius = false, strict = false;
   std::optional<double> exaggeration;
   double gauge_resolution_um = 1.0;
 };
@@ -37,6 +37,7 @@ int runEvaluate(const EvaluateArgs& a) {
   req.cycle_starts = a.cycle_starts;
   req.out_dir = a.out;
   req.gauge_resolution_um = a.gauge_resolution_um;
+  req.strict = a.strict;
   const auto f = evaluate::evaluateTestPiece(m, req);
   const double exaggeration = a.exaggeration.value_or(report::defaultSceneExaggeration(f));
   const std::string scene = a.scene.empty() ? "" : report::evaluationSceneGltf(m, f, a.points, exaggeration);
@@ -75,6 +76,7 @@ Subcommand addEvaluateCommand(CLI::App& app) {
   ev->add_option("--format", a->format, "auto, linuxcnc, fanuc, csv, cmm, qif, dmis or gauge")
       ->check(CLI::IsMember({"auto", "linuxcnc", "fanuc", "csv", "cmm", "qif", "dmis", "gauge"}))->capture_default_str();
   ev->add_flag("--free-radius", a->free_radius, "sphere centres from the free-radius fit (default: known radius)");
+  ev->add_flag("--strict", a->strict, "QIF export: refuse what the lenient reader reads with a warning (docs/interop.md)");
   ev->add_option("--scene", a->scene, "also write a glTF scene (the sphere campaign, or the test piece with its deviations)");
   ev->add_option("--exaggeration", a->exaggeration, "scale of the error vectors in the scene (default: 10000 sphere campaign, 1000 test piece)");
   ev->add_option("--gauge-resolution-um", a->gauge_resolution_um,

@@ -20,7 +20,7 @@ struct FitArgs {
   std::optional<double> radius_mm, outliers_k, point_u_um;
   int outlier_rounds = 10;
   double outlier_max_fraction = 0.2;
-  bool json = false;
+  bool json = false, strict = false;
 };
 
 Eigen::Vector3d parseVector(const std::string& text, const std::string& option) {
@@ -50,8 +50,10 @@ int runFit(const FitArgs& a) {
     req.side = a.material == "inside" ? geometry::MaterialSide::Inside : geometry::MaterialSide::Outside;
   if (!a.approach.empty()) req.approach = parseVector(a.approach, "--approach");
   if (a.point_u_um) req.point_u_mm = *a.point_u_um / 1000.0;
-  const auto cloud = evaluate::readPointCloud(a.points, a.format, {a.feature, a.cycle});
-  const auto rep = evaluate::fitFeature(cloud, req);
+  const auto cloud = evaluate::readPointCloud(a.points, a.format, {a.feature, a.cycle, a.strict});
+  auto rep = evaluate::fitFeature(cloud, req);
+  // The exchange file's own warnings (lenient reading) first: they say where the points came from.
+  rep.warnings.insert(rep.warnings.begin(), cloud.warnings.begin(), cloud.warnings.end());
   if (a.json) {
     std::fputs(evaluate::featureFitJson(cloud, rep).c_str(), stdout);
     for (const auto& w : rep.warnings) std::fprintf(stderr, "probeloop: warning: %s\n", w.c_str());
@@ -65,15 +67,18 @@ int runFit(const FitArgs& a) {
 
 Subcommand addFitCommand(CLI::App& app) {
   auto fa = std::make_shared<FitArgs>();
-  auto* fit = app.add_subcommand("fit", "Fit one geometric element to a point cloud (CSV, NIST .ds, XYZ, PLY)");
+  auto* fit = app.add_subcommand("fit", "Fit one geometric element to a point cloud (CSV, NIST .ds, XYZ, PLY) or to one "
+                                "feature's points in a QIF 3.0 Results or DMIS output file");
   fit->add_option("kind", fa->kind, "line2d, line3d, plane, circle2d, circle3d, sphere, cylinder or cone")
       ->required()->check(CLI::IsMember({"line2d", "line3d", "plane", "circle2d", "circle3d", "sphere", "cylinder", "cone"}));
-  fit->add_option("points", fa->points, "points file")->required()->check(inputFile("a points file (CSV, NIST .ds, XYZ or PLY)"));
+  fit->add_option("points", fa->points, "points file")->required()->check(inputFile("a points file (CSV, NIST .ds, XYZ, PLY, QIF or DMIS)"));
   fit->add_option("--method", fa->method, "ls (least squares), mz (minimum zone), mi (maximum inscribed), mc (minimum circumscribed)")
       ->check(CLI::IsMember({"ls", "mz", "mi", "mc"}))->capture_default_str();
-  fit->add_option("--format", fa->format, "auto, csv, ds, xyz or ply")
-      ->check(CLI::IsMember({"auto", "csv", "ds", "xyz", "ply"}))->capture_default_str();
-  fit->add_option("--feature", fa->feature, "points CSV: use the rows of this feature only (required when the file holds several)");
+  fit->add_option("--format", fa->format, "auto, csv, ds, xyz, ply, qif (QIF 3.0 Results) or dmis (DMIS output)")
+      ->check(CLI::IsMember({"auto", "csv", "ds", "xyz", "ply", "qif", "dmis"}))->capture_default_str();
+  fit->add_option("--feature", fa->feature, "points CSV: use the rows of this feature only; QIF/DMIS: this feature's measured "
+                  "points (required when the file holds several)");
+  fit->add_flag("--strict", fa->strict, "QIF: refuse what the lenient reader would read with a warning (docs/interop.md)");
   fit->add_option("--cycle", fa->cycle, "points CSV: use the rows of this cycle only (required when the file holds several)");
   fit->add_option("--tip-radius", fa->tip_radius_mm, "stylus tip radius, mm: the points are tip centres")->capture_default_str();
   fit->add_option("--material", fa->material, "material side for tip compensation when the file has no approach directions: inside (ball, shaft) or outside (bore)")

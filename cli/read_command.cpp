@@ -16,7 +16,7 @@ namespace {
 
 struct ReadArgs {
   std::string file;
-  bool json = false;
+  bool json = false, strict = false;
 };
 
 int runRead(const ReadArgs& a) {
@@ -29,11 +29,12 @@ int runRead(const ReadArgs& a) {
   }
   if (interop::looksLikeDmis(text)) {  // a program (DMISMN: its nominals and PTMEAS points) or output (FILNAM)
     const bool program = interop::isDmisProgram(text);
-    const auto d = program ? interop::parseDmisProgram(text, a.file) : interop::parseDmisOutput(text, a.file);
+    const auto d = program ? interop::parseDmisProgram(text, a.file)
+                           : interop::parseDmisOutput(text, a.file, interop::CmmReadOptions{a.strict});
     std::fputs((a.json ? interop::cmmDocumentJson(d) : interop::cmmDocumentText(d)).c_str(), stdout);
     return 0;
   }
-  auto d = interop::parseQifResults(text, a.file);
+  auto d = interop::parseQifResults(text, a.file, interop::CmmReadOptions{a.strict});
   if (d.runs == 0 && d.features.empty()) {
     try {
       d = interop::parseQifPlan(text, a.file);
@@ -51,7 +52,9 @@ Subcommand addReadCommand(CLI::App& app) {
   auto* rd = app.add_subcommand("read", "What probeloop reads in a CMM exchange file (QIF 3.0 Results or Plan, DMIS output or "
                                 "program): features, points, units");
   rd->add_option("file", a->file, "QIF 3.0 or DMIS file")->required()->check(inputFile());
-  rd->add_flag("--json", a->json, "print JSON (every feature with its geometry and points, in mm)");
+  rd->add_flag("--json", a->json, "print JSON (every feature with its geometry and points, in mm; the warnings)");
+  rd->add_flag("--strict", a->strict, "QIF: refuse what the lenient reader reads with a warning (element order, a dangling or "
+               "self-referencing id, an unknown extension, a missing PointList), at its line");
   return {rd, [a] { return runRead(*a); }};
 }
 

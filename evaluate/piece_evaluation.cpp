@@ -68,6 +68,13 @@ EvaluationFiles sphere(const parts::PlanManifest& planned, const EvaluateRequest
   return f;
 }
 
+// The input file's reader warnings, one "warning: file:line: ..." line each, after the results.
+std::string warningLines(const std::vector<std::string>& warnings) {
+  std::string o;
+  for (const auto& w : warnings) o += "warning: " + w + "\n";
+  return o;
+}
+
 EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateRequest& r) {
   if (r.free_radius) throw InputError(r.input_file, 0, "--free-radius applies to sphere-artifact campaigns, not to the thermal test piece");
   const std::string text = readFile(r.input_file);
@@ -77,7 +84,7 @@ EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateReq
   TtpEvaluation e;
   std::optional<TtpPoints> points;
   if (fmt == "cmm" || fmt == "qif" || fmt == "dmis") {  // a CSV export, QIF 3.0 Results or DMIS output
-    points = readTtpCmmExport(r.input_file, text, m);
+    points = readTtpCmmExport(r.input_file, text, m, r.strict);
     e = evaluateThermalTestPiece(m, *points, opt);
   } else if (fmt == "linuxcnc" || fmt == "fanuc" || fmt == "log" || fmt == "csv") {
     points = readTtpOnMachine(r.input_file, text, fmt, m);
@@ -96,6 +103,7 @@ EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateReq
   f.report_md = ttpReport(e);
   f.stdout_text = ttpStdout(e, pathIn(r.out_dir, EvaluationFiles::kErrorsCsv), pathIn(r.out_dir, EvaluationFiles::kEvaluationJson),
                             pathIn(r.out_dir, EvaluationFiles::kReportMd));
+  if (points) f.stdout_text += warningLines(points->warnings);
   f.thermal_test_piece = std::move(e);
   return f;
 }
@@ -116,7 +124,7 @@ EvaluationFiles steppedWorkpiece(const parts::PlanManifest& m, const EvaluateReq
   if (log_fmt == "cmm" || log_fmt == "gauge" || log_fmt == "qif" || log_fmt == "dmis")
     throw InputError(r.probe_log, 0, "--probe-log: expected the on-machine probe log (PT lines) or points CSV, found a " + log_fmt + " file");
   EvaluationFiles f;
-  const auto cmm = readTtpCmmExport(r.input_file, text, m);
+  const auto cmm = readTtpCmmExport(r.input_file, text, m, r.strict);
   f.stepped_workpiece = evaluateSteppedWorkpiece(m, cmm, readTtpOnMachine(r.probe_log, log, log_fmt, m));
   if (!r.compare_with.empty()) compareWithBefore(*f.stepped_workpiece, m, r.compare_with);
   const auto& e = *f.stepped_workpiece;
@@ -125,7 +133,7 @@ EvaluationFiles steppedWorkpiece(const parts::PlanManifest& m, const EvaluateReq
   f.report_md = swReport(e);
   f.compensation_json = swCompensationFile(e);
   f.results_qif = evaluationQif(m, &cmm, f.errors_csv);
-  f.stdout_text = swStdout(e, r.out_dir);
+  f.stdout_text = swStdout(e, r.out_dir) + warningLines(cmm.warnings);
   return f;
 }
 

@@ -27,8 +27,10 @@ std::string extensionFormat(const std::string& path) {
   if (ext == "ds") return "ds";
   if (ext == "xyz" || ext == "txt" || ext == "asc") return "xyz";
   if (ext == "ply") return "ply";
+  if (ext == "qif") return "qif";
+  if (ext == "dmo") return "dmis";
   throw InputError(path, 0, "cannot tell the point format from the extension '." + ext +
-                                "'; give --format csv|ds|xyz|ply");
+                                "'; give --format csv|ds|xyz|ply|qif|dmis");
 }
 
 // Splits a line on blanks and commas.
@@ -396,8 +398,9 @@ PointCloud readPointCloud(const std::string& path, const std::string& format_in,
   PointCloud pc;
   pc.file = path;
   pc.format = format_in == "auto" || format_in.empty() ? extensionFormat(path) : format_in;
-  if (!feature.empty() && pc.format != "csv")
-    throw InputError(path, 0, "--feature selects rows of a points CSV; this file is " + pc.format);
+  const bool exchange = pc.format == "qif" || pc.format == "dmis";
+  if (!feature.empty() && pc.format != "csv" && !exchange)
+    throw InputError(path, 0, "--feature selects rows of a points CSV or a feature of a QIF/DMIS file; this file is " + pc.format);
   if (!select.cycle.empty() && pc.format != "csv")
     throw InputError(path, 0, "--cycle selects rows of a points CSV; this file is " + pc.format);
   // Binary PLY holds NUL bytes; every other format is text (NUL refused, UTF-16 transcoded).
@@ -406,7 +409,8 @@ PointCloud readPointCloud(const std::string& path, const std::string& format_in,
   else if (pc.format == "ds") readDs(pc, text);
   else if (pc.format == "xyz") readXyz(pc, text);
   else if (pc.format == "ply") readPly(pc, text);
-  else throw InputError(path, 0, "unknown point format '" + pc.format + "'; expected csv, ds, xyz or ply");
+  else if (exchange) readCmmExchange(pc, text, select);
+  else throw InputError(path, 0, "unknown point format '" + pc.format + "'; expected csv, ds, xyz, ply, qif or dmis");
   if (pc.points_mm.empty()) throw InputError(path, 0, "no points in the file");
   return pc;
 }

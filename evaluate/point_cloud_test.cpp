@@ -197,3 +197,38 @@ TEST(PointCloud, UnknownExtensionAsksForFormat) {
   const auto e = writeTemp("empty.xyz", "# nothing\n");
   EXPECT_NE(errorOf(e).find("no points"), std::string::npos);
 }
+
+// A QIF 3.0 Results file (issue 34): one feature's measured points by name, with the lenient
+// reader's warning (a self-referencing point-set id) carried along; strict refuses it.
+TEST(PointCloud, AQifFeatureByNameWithTheReadersWarnings) {
+  const auto p = writeTemp("r.qif", R"(<?xml version="1.0"?>
+<QIFDocument xmlns="http://qifstandards.org/xsd/qif3" versionQIF="3.0.0">
+<Results><MeasurementResultsSet n="1"><MeasurementResults id="1">
+<MeasuredFeatures n="2">
+<PlaneFeatureMeasurement id="2"><FeatureName>TOP</FeatureName><PointList n="1"><WholePointSetId>3</WholePointSetId></PointList>
+<Location>0 0 5</Location><Normal>0 0 1</Normal></PlaneFeatureMeasurement>
+<PointFeatureMeasurement id="4"><FeatureName>P</FeatureName><PointList n="1"><WholePointSetId>4</WholePointSetId></PointList>
+<Location>7 8 9</Location></PointFeatureMeasurement>
+</MeasuredFeatures>
+<MeasuredPointSets n="2">
+<MeasuredPointSet id="3" count="3"><Points>0 0 5 1 0 5 0 1 5</Points></MeasuredPointSet>
+<MeasuredPointSet id="5" count="1"><Points>7 8 9</Points></MeasuredPointSet>
+</MeasuredPointSets>
+</MeasurementResults></MeasurementResultsSet></Results></QIFDocument>
+)");
+  const auto top = readPointCloud(p, "auto", {"TOP", ""});
+  EXPECT_EQ(top.format, "qif");
+  ASSERT_EQ(top.points_mm.size(), 3u);
+  EXPECT_EQ(top.points_mm[1], Eigen::Vector3d(1, 0, 5));
+  EXPECT_EQ(top.source_lines[0], 5);
+  ASSERT_EQ(top.warnings.size(), 1u);
+  EXPECT_EQ(top.warnings[0].rfind(p + ":7: WholePointSetId: no MeasuredPointSet with id 4", 0), 0u) << top.warnings[0];
+  EXPECT_EQ(readPointCloud(p, "auto", {"P", ""}).points_mm.at(0), Eigen::Vector3d(7, 8, 9));  // set 5, the only candidate
+  EXPECT_NE(errorOf(p).find("2 measured features with points (TOP, P): give --feature NAME"), std::string::npos) << errorOf(p);
+  try {
+    readPointCloud(p, "auto", {"TOP", "", true});
+    ADD_FAILURE() << "strict accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(p + ":7: WholePointSetId"), std::string::npos) << e.what();
+  }
+}

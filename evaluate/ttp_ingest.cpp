@@ -269,8 +269,9 @@ TtpPoints cmmPointsFromRows(const std::string& path, const std::string& format, 
 
 // A QIF 3.0 Results document or a DMIS output file: every measured feature's points, labelled
 // by its name, numbered in their order (the line: the feature measurement's).
-TtpPoints cmmResults(const std::string& path, const std::string& text, const parts::PlanManifest& m, bool qif) {
-  const auto d = qif ? interop::parseQifResults(text, path) : interop::parseDmisOutput(text, path);
+TtpPoints cmmResults(const std::string& path, const std::string& text, const parts::PlanManifest& m, bool qif, bool strict) {
+  const interop::CmmReadOptions options{strict};
+  const auto d = qif ? interop::parseQifResults(text, path, options) : interop::parseDmisOutput(text, path, options);
   if (d.runs > 1)
     throw InputError(path, 0, std::to_string(d.runs) + " MeasurementResults (runs) in one file: evaluate reads one part's "
                                                       "measurement; write each run to its own file");
@@ -283,14 +284,16 @@ TtpPoints cmmResults(const std::string& path, const std::string& text, const par
     throw InputError(path, 0, std::string("no measured points (") + (qif ? "MeasuredPointSets" : "FA(<feature>_Pnn)=FEAT/POINT") + ") in " +
                                   std::to_string(d.features.size()) +
                                   " measured features: the evaluation fits its own planes and needs the points");
-  return cmmPointsFromRows(path, qif ? "qif" : "dmis", rows, true, m);
+  auto out = cmmPointsFromRows(path, qif ? "qif" : "dmis", rows, true, m);
+  for (const auto& w : d.warnings) out.warnings.push_back(path + ":" + std::to_string(w.line) + ": " + w.what);
+  return out;
 }
 
 }  // namespace
 
-TtpPoints readTtpCmmExport(const std::string& path, const std::string& text, const parts::PlanManifest& m) {
-  if (interop::looksLikeQif(text)) return cmmResults(path, text, m, true);
-  if (interop::looksLikeDmis(text)) return cmmResults(path, text, m, false);
+TtpPoints readTtpCmmExport(const std::string& path, const std::string& text, const parts::PlanManifest& m, bool strict) {
+  if (interop::looksLikeQif(text)) return cmmResults(path, text, m, true, strict);
+  if (interop::looksLikeDmis(text)) return cmmResults(path, text, m, false, strict);
   const CsvTable t = parseCsv(text, path);
   auto col = [&](const char* a, const char* b) {
     const int c = t.column(a);

@@ -45,6 +45,7 @@ struct TtpPoints {
   TtpRoute route = TtpRoute::Cmm;
   std::string assigned_by;  // labels | nominal geometry | manifest positions
   std::vector<TtpPoint> points;
+  std::vector<std::string> warnings;  // what the exchange file's lenient reader warned about
 };
 
 struct TtpGaugeReading {
@@ -63,7 +64,9 @@ struct TtpGaugeReadings {
 // CMM export; a file that is not CSV a probe log ("log": LinuxCNC and Fanuc lines parse alike).
 std::string detectTtpFormat(const std::string& path, const std::string& text);
 
-TtpPoints readTtpCmmExport(const std::string& path, const std::string& text, const parts::PlanManifest& m);
+// QIF and DMIS exports are read leniently (docs/interop.md#lenient-reading): the reader's
+// warnings land in TtpPoints::warnings ("file:line: ..."); strict refuses them instead.
+TtpPoints readTtpCmmExport(const std::string& path, const std::string& text, const parts::PlanManifest& m, bool strict = false);
 // format: csv (the points CSV) or linuxcnc | fanuc | log (a PT log).
 TtpPoints readTtpOnMachine(const std::string& path, const std::string& text, const std::string& format,
                            const parts::PlanManifest& m);

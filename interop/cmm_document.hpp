@@ -62,6 +62,20 @@ struct CmmMove {
   bool probing = false;
 };
 
+// Reading: a producer's mistake that keeps the meaning (element order, a dangling or
+// self-referencing id, an unknown extension, a missing optional block), read anyway: the line it
+// stands on and what was done (docs/interop.md#lenient-reading).
+struct CmmWarning {
+  int line = 0;
+  std::string what;
+};
+
+// How a reader treats those mistakes: strict refuses them (InputError at the same line, with
+// the same words), as every reader did before issue 34.
+struct CmmReadOptions {
+  bool strict = false;
+};
+
 struct CmmDocument {
   std::string file;       // reading: the path, for messages
   std::string part_name;  // writing: in the DMIS program's title and the content hash of the QIF QPId
@@ -72,6 +86,14 @@ struct CmmDocument {
   std::string length_unit = "mm";
   int runs = 0;
   std::vector<std::string> notes;
+  std::vector<CmmWarning> warnings;
+  // Reading results: every measured point set in the file and its points, assigned to a feature
+  // or not (QIF MeasuredPointSets; DMIS: the features' points).
+  int point_sets = 0;
+  std::size_t point_set_points = 0;
 };
+
+// "FILE:LINE: warning: WHAT", as the CLI prints each warning (stderr, or a read's text output).
+std::string cmmWarningText(const CmmDocument& d, const CmmWarning& w);
 
 }  // namespace probeloop::interop

@@ -398,7 +398,7 @@ CmmDocument parseDmisProgram(const std::string& text, const std::string& file_na
   return d;
 }
 
-CmmDocument parseDmisOutput(const std::string& text, const std::string& file_name) {
+CmmDocument parseDmisOutput(const std::string& text, const std::string& file_name, const CmmReadOptions& options) {
   Parser p(file_name);
   CmmDocument d;
   d.file = file_name;
@@ -411,8 +411,19 @@ CmmDocument parseDmisOutput(const std::string& text, const std::string& file_nam
   };
   std::vector<Actual> all;
   std::map<std::string, int> skipped;
-  for (const auto& s : statements(text)) {
+  const auto all_statements = statements(text);
+  bool ended = false;
+  // A form mistake that keeps what was read: a warning, or refused when strict.
+  auto lenient = [&](int line, const std::string& problem, const std::string& done) {
+    if (options.strict) p.fail(line, problem);
+    d.warnings.push_back({line, problem + "; " + done});
+  };
+  for (const auto& s : all_statements) {
     std::string prefix, lab, rest;
+    if (ended) {
+      lenient(s.line, "statements after ENDFIL", "passed over");
+      break;
+    }
     requireLabel(p, s);
     if (s.text.rfind("UNITS/", 0) == 0) {
       units(p, s);
@@ -431,10 +442,16 @@ CmmDocument parseDmisOutput(const std::string& text, const std::string& file_nam
       all.push_back(a);
       continue;
     }
-    if (s.text.rfind("ENDFIL", 0) == 0) break;
+    if (s.text.rfind("ENDFIL", 0) == 0) {
+      ended = true;
+      continue;
+    }
     if (s.text.rfind("FILNAM", 0) == 0 || s.text.rfind("DMISMN", 0) == 0) continue;  // the header
     ++skipped[keyword(s.text)];
   }
+  if (!ended && !all_statements.empty())
+    lenient(all_statements.back().line, "no ENDFIL after the last statement (the file may be cut short)",
+            "what is there was read");
   // Features: every actual that is not a point of another feature; nominals fill in.
   std::map<std::string, std::size_t> index;
   auto ownerOf = [&](const std::string& l) -> std::string {

@@ -38,7 +38,10 @@ std::string dmisProgram(const CmmDocument& plan, const std::string& title);
 std::string dmisOutput(const CmmDocument& results, const std::string& title);
 
 CmmDocument parseDmisProgram(const std::string& text, const std::string& file_name);
-CmmDocument parseDmisOutput(const std::string& text, const std::string& file_name);
+// Lenient (docs/interop.md#lenient-reading): an output without ENDFIL (perhaps cut short: what
+// is there is read) and statements after ENDFIL (passed over) are warnings with their line;
+// options.strict refuses them.
+CmmDocument parseDmisOutput(const std::string& text, const std::string& file_name, const CmmReadOptions& options = {});
 
 // A DMIS text: its first statement (after comments) is DMISMN or FILNAM (DMISMD); a program
 // when it is DMISMN or DMISMD.

@@ -127,6 +127,31 @@ void expectRefused(const std::string& text, const std::string& want, bool progra
   }
 }
 
+// Lenient (issue 34): an output without ENDFIL is read with a warning at its last statement,
+// statements after ENDFIL are passed over with a warning at the first; strict refuses both there.
+TEST(Dmis, AMissingEndfilAndStatementsAfterItAreWarned) {
+  const std::string body = "FILNAM/'x'\nFA(P1)=FEAT/POINT,CART,1,2,3,0,0,1\n";
+  const auto cut = parseDmisOutput(body, "cut.dmo");
+  ASSERT_EQ(cut.warnings.size(), 1u);
+  EXPECT_EQ(cut.warnings[0].line, 2);
+  EXPECT_EQ(cut.warnings[0].what, "no ENDFIL after the last statement (the file may be cut short); what is there was read");
+  ASSERT_EQ(cut.features.size(), 1u);
+  const auto after = parseDmisOutput(body + "ENDFIL\nFA(P2)=FEAT/POINT,CART,4,5,6,0,0,1\n", "after.dmo");
+  ASSERT_EQ(after.warnings.size(), 1u);
+  EXPECT_EQ(after.warnings[0].line, 4);
+  EXPECT_EQ(after.features.size(), 1u);  // P2 passed over
+  EXPECT_TRUE(parseDmisOutput(body + "ENDFIL\n", "ok.dmo").warnings.empty());
+  for (const auto& [text, want] : {std::pair<std::string, std::string>{body, "cut.dmo:2: no ENDFIL after the last statement (the file may be cut short)"},
+                                   {body + "ENDFIL\nFA(P2)=FEAT/POINT,CART,4,5,6,0,0,1\n", "cut.dmo:4: statements after ENDFIL"}}) {
+    try {
+      parseDmisOutput(text, "cut.dmo", CmmReadOptions{true});
+      ADD_FAILURE() << "strict read accepted: " << want;
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()), want);
+    }
+  }
+}
+
 TEST(Dmis, RefusesWhatDoesNotAddUp) {
   const std::string f = "DMISMN/'x',05.2\nF(A)=FEAT/PLANE,CART,0,0,0,0,0,1\n";
   expectRefused(f + "MEAS/PLANE,F(A),3\nPTMEAS/CART,0,0,0,0,0,1\nENDMES\n", "bad.dmi:3: MEAS/..,F(A),3: 1 PTMEAS in the block");

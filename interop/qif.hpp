@@ -21,10 +21,19 @@
 // element by the declared units). A document with no FileUnits is read in mm, with a note.
 // Characteristic measurements with a Value are returned by their item's name.
 // Contract: InputError with file:line for what is not QIF 3 (another root, namespace or
-// versionQIF), a point set whose Points do not hold 3 x count numbers, a reference to a point
-// set that is not there, a number that does not parse, an unknown length unit; binary point
-// sets (BinaryPoints) are refused with the reason. Nothing is guessed silently: what is passed
-// over is listed in notes.
+// versionQIF), a point set whose Points do not hold 3 x count numbers (of a set a feature
+// reads), a number that does not parse, an unknown length unit; binary point sets
+// (BinaryPoints) are refused with the reason. Nothing is guessed silently: what is passed over
+// is listed in notes, what is read despite a producer's mistake in warnings.
+// Lenient (docs/interop.md#lenient-reading): what a producer got wrong without changing the
+// meaning is read with a warning in the document's warnings (its line, what was done):
+// elements out of the XSD's order (MeasurementResults, feature measurements), a PointList id
+// that names no MeasuredPointSet (dangling, or the measurement's own id: the only unreferenced
+// set on the feature's measured geometry is assigned, else the points stay unassigned), a
+// feature measurement without PointList whose unreferenced set lies on its geometry
+// (assigned), elements in another namespace (passed over). options.strict refuses each of
+// them instead (InputError at the same line). Every MeasuredPointSet is counted
+// (point_sets, point_set_points), referenced or not.
 #pragma once
 #include <string>
 
@@ -35,14 +44,14 @@ namespace probeloop::interop {
 std::string qifPlan(const CmmDocument& plan);
 std::string qifResults(const CmmDocument& results);
 
-CmmDocument readQifResults(const std::string& path);
+CmmDocument readQifResults(const std::string& path, const CmmReadOptions& options = {});
 // A QIF plan's features (nominal geometry, internal/external from the definition) with their
 // planned points (NominalPointSets' MeasurePoints, by the nominal's PointList); the name is the
 // nominal's Name, else its item's FeatureName, else empty. InputError as above, and for a
 // plan without feature nominals.
 CmmDocument readQifPlan(const std::string& path);
 CmmDocument parseQifPlan(const std::string& text, const std::string& file_name);
-CmmDocument parseQifResults(const std::string& text, const std::string& file_name);
+CmmDocument parseQifResults(const std::string& text, const std::string& file_name, const CmmReadOptions& options = {});
 
 // True when a text looks like a QIF document (an XML root QIFDocument), for format detection.
 bool looksLikeQif(const std::string& text);

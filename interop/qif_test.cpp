@@ -147,9 +147,9 @@ TEST(Qif, LengthsAreConvertedToMillimetres) {
   EXPECT_EQ(f.line, 7);
 }
 
-void expectRefused(const std::string& xml, const std::string& want) {
+void expectRefused(const std::string& xml, const std::string& want, bool strict = false) {
   try {
-    parseQifResults(xml, "bad.qif");
+    parseQifResults(xml, "bad.qif", CmmReadOptions{strict});
     ADD_FAILURE() << "accepted; expected '" << want << "'";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
@@ -172,8 +172,9 @@ TEST(Qif, RefusesWhatIsNotQif3OrDoesNotAddUp) {
   };
   expectRefused(with("count=\"5\"", "count=\"6\""), "Points: 15 numbers, expected 18");
   const auto p = good.find("<WholePointSetId>") + 17;
+  // A dangling id: refused when strict (read with a warning otherwise: qif_lenient_test.cpp).
   expectRefused(with(good.substr(p, good.find('<', p) - p) + "</WholePointSetId>", "99</WholePointSetId>"),
-                "WholePointSetId: no MeasuredPointSet with id 99");
+                "WholePointSetId: no MeasuredPointSet with id 99", true);
   expectRefused(with("<Points>", "<Points>NaN "), "Points: 'NaN' is not a finite number");
   expectRefused(with("<UnitName>mm<", "<UnitName>furlong<"), "UnitName: 'furlong' is not a length unit");
   // Counts: beyond the bound (3 x count would overflow), and 0 with points given.

@@ -8,6 +8,10 @@
 
 namespace probeloop::interop {
 
+std::string cmmWarningText(const CmmDocument& d, const CmmWarning& w) {
+  return d.file + ":" + std::to_string(w.line) + ": warning: " + w.what;
+}
+
 namespace {
 
 std::string kindOf(const CmmFeature& f) { return f.kind == CmmFeatureKind::Other ? f.kind_name : cmmFeatureKindName(f.kind); }
@@ -62,7 +66,11 @@ std::string cmmDocumentText(const CmmDocument& d) {
   for (const auto& c : d.characteristics)
     o << "  characteristic " << c.name << " = " << formatNumber(c.value, 9) << (c.angular ? " rad" : " mm")
       << (std::isfinite(c.u) ? " (u " + formatNumber(c.u, 9) + ")" : std::string()) << "\n";
+  if (d.point_sets > 0)
+    o << "  measured point sets: " << d.point_sets << " with " << d.point_set_points << " points, " << points
+      << " of them assigned to features\n";
   for (const auto& n : d.notes) o << "  note: " << n << "\n";
+  for (const auto& w : d.warnings) o << "  " << cmmWarningText(d, w) << "\n";
   return o.str();
 }
 
@@ -87,6 +95,9 @@ std::string cmmDocumentJson(const CmmDocument& d) {
     cs.push_back(x);
   }
   j["notes"] = d.notes;
+  if (d.point_sets > 0) j["point_sets"] = {{"count", d.point_sets}, {"points", d.point_set_points}};
+  auto& ws = j["warnings"] = nlohmann::ordered_json::array();
+  for (const auto& w : d.warnings) ws.push_back({{"line", w.line}, {"what", w.what}});
   return j.dump(2) + "\n";
 }
 

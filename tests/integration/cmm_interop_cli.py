@@ -92,6 +92,20 @@ if code == 0:
         a, b = numbers(f"{T}/ev-csv/errors.csv"), numbers(f"{T}/ev-qif/errors.csv")
         check(f"the QIF route gives the CSV route's errors.csv, every printed digit ({len(a) - 1} cycles)", a == b and len(a) > 2,
               next((f"{x.strip()} | {y.strip()}" for x, y in zip(a, b) if x != y), "row count"))
+        # A vendor's extension in the results (issue 34): read with a warning at its line, the same
+        # errors.csv; refused under --strict.
+        qif = open(f"{T}/run/cmm_results.qif").read()
+        at = qif.index("</MeasurementResults>")
+        ext_line = qif[:at].count("\n") + 1
+        open(f"{W}/vendor.qif", "w").write(qif[:at] + '<v:Probe xmlns:v="urn:vendor">T1</v:Probe>' + qif[at:])
+        c4, out4, e4 = run("evaluate", f"{W}/vendor.qif", "--manifest", f"{T}/plan/plan.json", "--out", f"{T}/ev-vendor")
+        check(f"evaluate: a vendor extension is warned at line {ext_line} in stdout, the same errors.csv",
+              c4 == 0 and any(l.startswith(f"warning: {W}/vendor.qif:{ext_line}: MeasurementResults: unknown extension Probe")
+                              for l in out4.split("\n"))
+              and numbers(f"{T}/ev-vendor/errors.csv") == a, out4[-600:] + e4)
+        c5, _, e5 = run("evaluate", f"{W}/vendor.qif", "--manifest", f"{T}/plan/plan.json", "--out", f"{T}/ev-strict", "--strict")
+        check("evaluate --strict: refused at that line, nothing written", c5 != 0 and f"vendor.qif:{ext_line}: MeasurementResults: unknown "
+              "extension Probe" in e5 and not os.path.exists(f"{T}/ev-strict/errors.csv"), e5)
         # The evaluation's own results.qif: valid, and its characteristics are errors.csv's values.
         ok, e = valid(f"{T}/ev-qif/results.qif")
         check("the evaluation's results.qif validates against the QIF 3.0 XSD", ok, e)
@@ -130,6 +144,14 @@ if code == 0:
     if code == 0:
         c3, out3, e3 = run("evaluate", f"{T}/run-dmis/cmm_results.dmo", "--manifest", f"{T}/plan/plan.json", "--out", f"{T}/ev-dmis")
         check("evaluate the DMIS output", c3 == 0 and "assigned by labels" in out3, e3)
+        # fit on an exchange file (issue 34): feature TOP's 12 points from the DMIS output, from the
+        # QIF results of the same run and from cmm_export.csv's TOP rows give one plane.
+        fits = []
+        for f in (f"{T}/run-dmis/cmm_results.dmo", f"{T}/run-dmis/cmm_results.qif", f"{T}/run-dmis/cmm_export.csv"):
+            cf, of, ef = run("fit", "plane", f, "--feature", "TOP", "--json")
+            fits.append({q["name"]: q["value"] for q in json.loads(of)["parameters"]} if cf == 0 else ef)
+        check("fit plane --feature TOP: the DMIS output, the QIF results and the CSV export give one plane (1e-4 mm)",
+              all(isinstance(x, dict) for x in fits) and all(abs(fits[i][k] - fits[2][k]) < 1e-4 for i in (0, 1) for k in fits[2]), fits)
         if c3 == 0 and c1 == 0:
             a, b = numbers(f"{T}/ev-csv/errors.csv"), numbers(f"{T}/ev-dmis/errors.csv")
             check(f"the DMIS route gives the CSV route's errors.csv, every printed digit ({len(a) - 1} cycles)", a == b and len(a) > 2,

@@ -1,0 +1,204 @@
+#!/usr/bin/env python3
+"""Files from other producers through the real CLI (issue 34 items 1, 2 and 4), on the corpus
+of tests/data/foreign (README.md there has each file's provenance):
+
+- CheckMate's QIF 3.0 results (SolidWorks 2016): `probeloop read` reads 691 measured points in
+  12 MeasuredPointSets (counted here from the file's text, independently of probeloop) and
+  reports the two producer mistakes as warnings with their lines (the self-referencing
+  WholePointSetId of POINT5, the missing PointList of POINT3; their lines found here by
+  searching the text); every point is assigned to a feature;
+- `--strict` refuses the file at the self-reference's line, with the message of the warning;
+- `probeloop fit cylinder FILE --feature CYL_1` fits the 18 tip centres: its radius and axis
+  agree with a least-squares cylinder computed here (Gauss-Newton in pure Python) within
+  1e-6 mm / 1e-6; with the file's ProbeRadius compensated (a bore: --material outside) the
+  diameter agrees with CheckMate's own measured 30.11094 mm within 1 um, and its axis with
+  CheckMate's direction within 0.1 mrad; the warnings reach fit's output (text and --json).
+- the DMSC's demoQIFout.py results (features only): read with its four features and their
+  diameters (from the file's text), no points, no warning; `fit` refuses it for want of points.
+
+Needs $PROBELOOP and $PROBELOOP_SOURCE_DIR."""
+import json, math, os, re, subprocess, sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from checks import Checks  # noqa: E402
+
+PL = os.environ["PROBELOOP"]
+SRC = os.environ["PROBELOOP_SOURCE_DIR"]
+CM = os.path.join(SRC, "tests", "data", "foreign", "qif", "QIF_PTS_SAMPLE.QIF")
+check = Checks()
+
+
+def run(*args):
+    p = subprocess.run([PL, *args], capture_output=True, text=True)
+    return p.returncode, p.stdout, p.stderr
+
+
+text = open(CM, encoding="utf-8").read()
+lines = text.split("\n")
+
+# The file's point sets, from its text: ids, counts and the numbers between <Points> tags.
+sets = re.findall(r'<MeasuredPointSet id="(\d+)" count="(\d+)">(.*?)</MeasuredPointSet>', text, re.S)
+points_by_set = {}
+for sid, count, body in sets:
+    nums = [float(x) for x in re.sub(r"<!--.*?-->", "", re.search(r"<Points>(.*?)</Points>", body, re.S).group(1), flags=re.S).split()]
+    points_by_set[sid] = [nums[i:i + 3] for i in range(0, len(nums), 3)]
+n_points = sum(len(p) for p in points_by_set.values())
+check(f"the file holds {len(sets)} point sets with {n_points} points (counted from its text)", len(sets) == 12 and n_points == 691,
+      (len(sets), n_points))
+self_ref = next(i + 1 for i, l in enumerate(lines) if "<WholePointSetId>828</WholePointSetId>" in l)
+no_list = next(i + 1 for i, l in enumerate(lines) if '<PointFeatureMeasurement id="776">' in l)
+
+# read: text and JSON.
+rc, out, err = run("read", CM)
+check("read: exit 0 (the strict reader refused the whole file)", rc == 0, err)
+# Assigned: every set whole, but DATUMA's RangePointSetId takes points 3..8 of its 8.
+rng = re.search(r'<RangePointSetId range="(\d+) (\d+)">', text)
+assigned = n_points - len(points_by_set["12"]) + int(rng.group(2)) - int(rng.group(1)) + 1
+check(f"read: '12 with 691 points, {assigned} of them assigned to features'",
+      f"measured point sets: 12 with 691 points, {assigned} of them assigned to features" in out, out[-1500:])
+w_self = f"{CM}:{self_ref}: warning: WholePointSetId: no MeasuredPointSet with id 828 in this MeasurementResults (it is the feature " \
+         f"measurement's own id); assigned MeasuredPointSet 829"
+check(f"read: the self-reference warned at line {self_ref} with what was done", w_self in out, out[-1500:])
+check(f"read: the missing PointList warned at line {no_list}",
+      f"{CM}:{no_list}: warning: PointFeatureMeasurement 776 has no PointList, but MeasuredPointSet 777" in out, out[-1500:])
+rc, js, err = run("read", CM, "--json")
+d = json.loads(js) if rc == 0 else {}
+ws = d.get("warnings", [])
+check("read --json: 2 warnings at the two lines", sorted(w["line"] for w in ws) == sorted([self_ref, no_list]), ws)
+check("read --json: point_sets 12, points 691", d.get("point_sets") == {"count": 12, "points": 691}, d.get("point_sets"))
+feats = {f["name"]: f for f in d.get("features", [])}
+check(f"read --json: 14 features with {assigned} points",
+      len(feats) == 14 and sum(len(f["points_mm"]) for f in feats.values()) == assigned, len(feats))
+p5 = feats.get("POINT5", {}).get("points_mm", [])
+check("read --json: POINT5 got set 829's point", len(p5) == 1 and all(abs(a - b) < 1e-12 for a, b in zip(p5[0], points_by_set["829"][0])), p5)
+
+# --strict: refused at the first warned line (POINT3's, before POINT5's), with the warning's problem.
+first = min(self_ref, no_list)
+rc, out, err = run("read", CM, "--strict")
+check(f"read --strict: refused at line {first}", rc != 0 and
+      f"{CM}:{first}: PointFeatureMeasurement 776 has no PointList, but MeasuredPointSet 777" in err, (rc, err))
+rc, out, err = run("fit", "cylinder", CM, "--feature", "CYL_1", "--strict")
+check("fit --strict: refused the same way", rc != 0 and f"{CM}:{first}: PointFeatureMeasurement 776" in err, (rc, err))
+
+
+# An independent least-squares cylinder: axis through (x0, y0, 0) along (a, b, 1)/|.|, radius r;
+# Gauss-Newton on the radial residuals with a numerical Jacobian (5 x 5 normal equations).
+def residuals(q, pts):
+    x0, y0, a, b, r = q
+    n = math.sqrt(a * a + b * b + 1)
+    d = (a / n, b / n, 1 / n)
+    out = []
+    for x, y, z in pts:
+        v = (x - x0, y - y0, z)
+        t = v[0] * d[0] + v[1] * d[1] + v[2] * d[2]
+        out.append(math.sqrt(sum((v[k] - t * d[k]) ** 2 for k in range(3))) - r)
+    return out
+
+
+def solve(A, y):
+    n = len(y)
+    M = [row[:] + [y[i]] for i, row in enumerate(A)]
+    for c in range(n):
+        p = max(range(c, n), key=lambda i: abs(M[i][c]))
+        M[c], M[p] = M[p], M[c]
+        for i in range(n):
+            if i != c:
+                f = M[i][c] / M[c][c]
+                M[i] = [M[i][k] - f * M[c][k] for k in range(n + 1)]
+    return [M[i][n] / M[i][i] for i in range(n)]
+
+
+def ls_cylinder(pts):
+    cx = sum(p[0] for p in pts) / len(pts)
+    cy = sum(p[1] for p in pts) / len(pts)
+    q = [cx, cy, 0.0, 0.0, sum(math.hypot(p[0] - cx, p[1] - cy) for p in pts) / len(pts)]
+    for _ in range(50):
+        r0 = residuals(q, pts)
+        J = []
+        for k in range(5):
+            h = 1e-7
+            qk = q[:]
+            qk[k] += h
+            J.append([(a - b) / h for a, b in zip(residuals(qk, pts), r0)])
+        A = [[sum(J[i][m] * J[j][m] for m in range(len(pts))) for j in range(5)] for i in range(5)]
+        g = [-sum(J[i][m] * r0[m] for m in range(len(pts))) for i in range(5)]
+        step = solve(A, g)
+        q = [a + b for a, b in zip(q, step)]
+        if max(abs(s) for s in step) < 1e-13:
+            break
+    n = math.sqrt(q[2] ** 2 + q[3] ** 2 + 1)
+    return q[4], (q[2] / n, q[3] / n, 1 / n), residuals(q, pts)
+
+
+cyl = points_by_set["797"]
+r_ls, d_ls, res = ls_cylinder(cyl)
+print(f"independent LS cylinder on set 797 ({len(cyl)} tip centres): r = {r_ls:.6f} mm, axis = "
+      f"({d_ls[0]:.7f}, {d_ls[1]:.7f}, {d_ls[2]:.7f}), max |residual| = {max(abs(x) for x in res) * 1000:.3f} um")
+
+
+def param(j, name):
+    return next((p["value"] for p in j.get("parameters", []) if p["name"] == name), None)
+
+
+def axis_of(j):
+    v = [param(j, k) for k in ("nx", "ny", "nz")]
+    return None if None in v else v
+
+
+def angle(u, v):
+    c = abs(sum(a * b for a, b in zip(u, v))) / math.sqrt(sum(a * a for a in u) * sum(b * b for b in v))
+    return math.acos(min(1.0, c))
+
+
+rc, js, err = run("fit", "cylinder", CM, "--feature", "CYL_1", "--json")
+check("fit cylinder --feature CYL_1 --json: exit 0", rc == 0, err)
+j = json.loads(js) if rc == 0 else {}
+el = j
+r_fit = param(j, "r_mm")
+ax = axis_of(el)
+check("fit: the cylinder of CYL_1's 18 points", j.get("element") == "cylinder" and j.get("input", {}).get("points") == 18, j.get("input"))
+print(f"fit cylinder CYL_1: r = {r_fit} mm, axis = {ax}, form = {j.get('form_um')} um")
+check(f"fit: radius {r_fit} mm = independent LS {r_ls:.6f} mm within 1e-6 mm", r_fit is not None and abs(r_fit - r_ls) < 1e-6,
+      (r_fit, r_ls))
+check("fit: axis = independent LS axis within 1e-6 rad", ax is not None and angle(ax, d_ls) < 1e-6, (ax, d_ls))
+check("fit --json: the two warnings in warnings[] and on stderr",
+      sum(1 for w in j.get("warnings", []) if f"{CM}:{self_ref}:" in w or f"{CM}:{no_list}:" in w) == 2
+      and f"{CM}:{self_ref}:" in err, (j.get("warnings"), err))
+
+# With the probe radius the file states (2.49978271104 mm, uncompensated tip centres of a bore).
+probe = float(re.search(r"<ProbeRadius>([0-9.]+)</ProbeRadius>", text).group(1))
+dia_cm = float(re.search(r'<CylinderFeatureMeasurement id="796">.*?<Diameter>([0-9.]+)</Diameter>', text, re.S).group(1))
+dir_cm = [float(x) for x in re.search(r'<CylinderFeatureMeasurement id="796">.*?<Direction>([^<]+)</Direction>', text, re.S).group(1).split()]
+rc, js, err = run("fit", "cylinder", CM, "--feature", "CYL_1", "--tip-radius", repr(probe), "--material", "outside", "--json")
+j = json.loads(js) if rc == 0 else {}
+el = j
+r_c = param(j, "r_mm")
+print(f"fit cylinder CYL_1, tip compensated: d = {None if r_c is None else 2 * r_c} mm, form = {j.get('form_um')} um")
+check(f"fit --tip-radius {probe} --material outside: diameter {None if r_c is None else 2 * r_c} mm = CheckMate's {dia_cm} mm within 1 um",
+      r_c is not None and abs(2 * r_c - dia_cm) < 0.001, (r_c, dia_cm, err))
+check("fit: axis = CheckMate's measured direction within 0.1 mrad", axis_of(el) is not None and angle(axis_of(el), dir_cm) < 1e-4,
+      (axis_of(el), dir_cm))
+
+rc, out, err = run("fit", "cylinder", CM, "--feature", "CYL_1")
+check("fit (text): exit 0, the warnings with their lines in the report", rc == 0 and f"{CM}:{self_ref}:" in out and f"{CM}:{no_list}:" in out,
+      out + err)
+print(out)
+rc, out, err = run("fit", "cylinder", CM)
+check("fit without --feature: refused, naming the features with points", rc != 0 and "give --feature NAME" in err and "CYL_1" in err, err)
+rc, out, err = run("fit", "cylinder", CM, "--feature", "NOPE")
+check("fit --feature NOPE: refused, listing the names", rc != 0 and "no feature named 'NOPE'" in err and "CYL_1" in err, err)
+
+# The DMSC's demoQIFout.py file: measured features only, no points.
+PY = os.path.join(SRC, "tests", "data", "foreign", "qif", "testPython30.qif")
+py = open(PY, encoding="utf-8").read()
+meas = re.findall(r"<(\w+)FeatureMeasurement id=", py)
+dias = [float(x) for x in re.findall(r"<Diameter>([0-9.]+)</Diameter>", py.split("<Results>")[1])]
+rc, js, err = run("read", PY, "--json")
+d = json.loads(js) if rc == 0 else {}
+got = [(f["kind"], f.get("measured", {}).get("diameter_mm")) for f in d.get("features", [])]
+check(f"testPython30: {len(meas)} measured features ({', '.join(meas)}; diameters {dias} from the text), no points, no warning",
+      rc == 0 and [k for k, _ in got] == [m.lower() for m in meas] and [x for _, x in got if x is not None] == dias
+      and all(not f["points_mm"] for f in d["features"]) and d["warnings"] == [] and "point_sets" not in d, (got, err))
+rc, out, err = run("fit", "cylinder", PY, "--feature", "DAT_B")
+check("testPython30: fit refuses a file without points", rc != 0 and f"no measured features with points in the file ({len(meas)} features)" in err, err)
+check.finish()
