@@ -96,6 +96,32 @@ std::vector<FeatureActual> parseFeatureActuals(const std::string& text, const st
   return out;
 }
 
+std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, int max_cycle) {
+  std::vector<FeatureActual> out;
+  for (const auto& c : d.features) {
+    FeatureActual f;
+    f.file = d.file;
+    f.line = c.line;
+    f.cycle = std::max(c.run, 1);
+    f.id = c.name;
+    f.kind = interop::cmmFeatureKindName(c.kind);
+    if (c.kind == interop::CmmFeatureKind::Sphere && !c.measured.given)
+      throw InputError(d.file, c.line, "sphere '" + c.name + "' has no measured Location (points only): the sphere artifact is "
+                                       "evaluated here from the centres the CMM reports");
+    if (max_cycle > 0 && f.cycle > max_cycle)
+      throw InputError(d.file, c.line, "measurement run " + std::to_string(f.cycle) + " (a cycle) is beyond the plan's " +
+                                           std::to_string(max_cycle) + " cycles");
+    f.location_mm = c.measured.location_mm;
+    f.direction = c.measured.direction;
+    f.size_mm = c.measured.diameter_mm;
+    f.form_um = c.measured.form_mm * 1e3;
+    f.n_points = static_cast<int>(std::min<std::size_t>(c.points.size(), 1000000000));
+    out.push_back(std::move(f));
+  }
+  if (out.empty()) throw InputError(d.file, 0, "no measured features in the file: nothing to evaluate");
+  return out;
+}
+
 SphereCentresFromFeatures sphereCentresFromFeatures(const std::vector<FeatureActual>& rows, const parts::PlanManifest& m) {
   constexpr double kNear_mm = 5.0, kDiameter_mm = 1.0;
   SphereCentresFromFeatures out;

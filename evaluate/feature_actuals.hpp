@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "interop/cmm_document.hpp"
 #include "parts/plan_manifest.hpp"
 
 namespace probeloop::evaluate {
@@ -33,13 +34,21 @@ struct FeatureActual {
   Eigen::Vector3d direction = Eigen::Vector3d::Zero();  // unit; zero for a sphere or point
   double size_mm = 0;                                   // diameter; NaN when not given
   double form_um = 0;                                   // NaN when not stated
-  int n_points = 0;
+  int n_points = 0;  // 0: not stated (QIF/DMIS features exported without their points)
   std::optional<Eigen::Vector3d> u_um;  // the CMM's stated standard uncertainty per coordinate
   std::optional<double> time_s;
 };
 
 // max_cycle > 0 refuses a cycle beyond it (the plan's cycles).
 std::vector<FeatureActual> parseFeatureActuals(const std::string& text, const std::string& file, int max_cycle = 0);
+
+// The measured features of a QIF 3.0 Results or DMIS output document (interop's readers) as
+// feature actuals: the cycle is the document's measurement run (QIF: the MeasurementResults in
+// order; DMIS output: 1), the id the feature's name, size and form as the file states them,
+// n_points the points it carries (0: none exported). A sphere without measured geometry (points
+// only) is refused with its line: this route reads the CMM's centres. Cycles beyond max_cycle
+// (> 0) are refused.
+std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, int max_cycle = 0);
 
 // True when a CSV text's header holds the feature-actuals columns (for --format auto).
 bool looksLikeFeatureActuals(const std::string& text);

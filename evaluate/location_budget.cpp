@@ -218,7 +218,8 @@ FeatureCentreU featureCentreU(const parts::PlanManifest& m, const FeatureActual&
     fo.fixed_radius_mm = m.sphere_radius_mm + m.tip_radius_mm;
     const Eigen::Matrix3d cov = geometry::fitSphere(pts, fo).covariance_unscaled.topLeftCorner<3, 3>();
     const double sigma = m.probe_repeatability_2sigma_um / 2 * 1e-3;
-    for (int a = 0; a < 3; ++a) u.u_mm(a) = sigma * std::sqrt(std::max(cov(a, a), 0.0) * per / f.n_points);
+    const int n = f.n_points > 0 ? f.n_points : per;  // not stated: the planned points
+    for (int a = 0; a < 3; ++a) u.u_mm(a) = sigma * std::sqrt(std::max(cov(a, a), 0.0) * per / n);
   }
   u.form_stated = std::isfinite(f.form_um);
   u.form_u_mm = (u.form_stated ? f.form_um : m.sphere_form_error_um) * 1e-3 / 2 / std::sqrt(3.0);

@@ -14,6 +14,7 @@
 #include "core/error.hpp"
 #include "core/input_file.hpp"
 #include "evaluate/feature_actuals.hpp"
+#include "interop/qif.hpp"
 #include "evaluate/ingest.hpp"
 #include "evaluate/ttp_ingest.hpp"
 
@@ -51,7 +52,15 @@ EvaluationFiles sphere(const parts::PlanManifest& planned, const EvaluateRequest
     // Only the fitted centres, no points (issue 34): the same location errors from them.
     const auto rows = parseFeatureActuals(text, r.input_file, m.cycles);
     f.sphere = evaluateSphereCampaignFromFeatures(m, sphereCentresFromFeatures(rows, m), r.input_file, opt);
+  } else if (r.format == "qif") {
+    // The measured sphere features of a QIF 3.0 Results file, one MeasurementResults per cycle.
+    // (A DMIS output holds one run: a campaign's cycles cannot be told apart in it; not read yet.)
+    const auto doc = interop::parseQifResults(readFile(r.input_file), r.input_file);
+    f.sphere = evaluateSphereCampaignFromFeatures(m, sphereCentresFromFeatures(featureActualsFromCmm(doc, m.cycles), m), r.input_file, opt);
   } else {
+    if (r.format != "auto" && r.format != "linuxcnc" && r.format != "fanuc" && r.format != "csv")
+      throw InputError("", 0, "--format '" + r.format + "': a sphere-artifact campaign takes auto, linuxcnc, fanuc, csv (points), "
+                              "features or qif (sphere centres a CMM reports)");
     f.sphere = evaluateSphereCampaign(m, readProbeRecords(r.input_file, parsePointsFormat(r.format), m), opt);
   }
   const auto& e = *f.sphere;

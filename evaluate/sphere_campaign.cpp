@@ -299,7 +299,8 @@ CampaignEvaluation evaluateSphereCampaignFromFeatures(const parts::PlanManifest&
       const FeatureActual& f = pit->second.feature;
       SphereMeasurement sm;
       sm.position = s.position;
-      sm.points = f.n_points;
+      const int n_points = f.n_points > 0 ? f.n_points : per;  // not stated: as planned
+      sm.points = n_points;
       if (f.time_s) {
         sm.time_s = *f.time_s;
       } else {
@@ -310,8 +311,8 @@ CampaignEvaluation evaluateSphereCampaignFromFeatures(const parts::PlanManifest&
         for (int i = 0; i < per; ++i) t += m.points[static_cast<std::size_t>((s.position - 1) * per + i)].time_in_cycle_s;
         sm.time_s = m.cycle_start_s[cyc - 1] + t / per;
       }
-      t_sum += sm.time_s * f.n_points;
-      n_sum += f.n_points;
+      t_sum += sm.time_s * n_points;
+      n_sum += n_points;
       sm.stated = pit->second;
       sm.stated_u = featureCentreU(m, f, s.position);
       ce.spheres.push_back(std::move(sm));

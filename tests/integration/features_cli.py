@@ -11,6 +11,8 @@ that evaluation.json:
   foreign ids in a shuffled order, the stated u per coordinate, a semicolon file with decimal
   commas and CRLF: every error agrees with the point route within the combined U
   sqrt(U_points^2 + U_features^2), and the largest difference per error is printed in units of it;
+- a QIF 3.0 Results file with only MeasuredFeatures (one MeasurementResults per cycle, the
+  point route's centres): the same errors; a sphere without its Location refused;
 - refusals with the file and line: an unknown kind, a missing column, two foreign rows on one
   place without time_s, a foreign row far from every sphere; a position without a centre in a
   cycle makes that cycle incomplete, listed as the point route lists it.
@@ -145,6 +147,41 @@ try:
     cb = [x for x in ev_f["cycles"][1]["spheres"][0]["centre_budgets"][0]["contributions"]
           if x["input"] == "sphere centre as the feature file states it"][0]
     check("a stated u is the centre's term", abs(cb["u"] - 0.6) < 1e-12 and "u_x_um of the file" in cb["basis"], cb)
+
+    # --- QIF 3.0 MeasuredFeatures only: one MeasurementResults per cycle, the centres, no points
+    def qif(ev, drop_location=False):
+        out = ['<?xml version="1.0" encoding="UTF-8"?>',
+               '<QIFDocument xmlns="http://qifstandards.org/xsd/qif3" versionQIF="3.0.0" idMax="9999">',
+               '  <FileUnits><PrimaryUnits><LinearUnit><SIUnitName>millimeter</SIUnitName><UnitName>mm</UnitName>'
+               '</LinearUnit></PrimaryUnits></FileUnits>',
+               f'  <Results><MeasurementResultsSet n="{len(ev["cycles"])}">']
+        i = 100
+        for c in ev["cycles"]:
+            i += 1
+            out.append(f'    <MeasurementResults id="{i}"><MeasuredFeatures n="{len(c["spheres"])}">')
+            for s in c["spheres"]:
+                i += 1
+                loc = "" if drop_location and s["position"] == 2 else "<Location>%r %r %r</Location>" % tuple(s["centre_mm"])
+                out.append(f'      <SphereFeatureMeasurement id="{i}"><FeatureName>S{s["position"]}</FeatureName>{loc}'
+                           '<Diameter>30</Diameter><Form>0.0004</Form></SphereFeatureMeasurement>')
+            out.append('    </MeasuredFeatures></MeasurementResults>')
+        out.append('  </MeasurementResultsSet></Results>\n</QIFDocument>')
+        return "\n".join(out) + "\n"
+    q = write("centres.qif", qif(ev_p))
+    code, out, err = run("evaluate", q, "--format", "qif", "--manifest", PLAN, "--out", f"{W}/qif")
+    ev_q = json.load(open(f"{W}/qif/evaluation.json")) if code == 0 else {"cycles": []}
+    bq = budgets(ev_q)
+    check("QIF MeasuredFeatures (spheres, no points): the same errors as the point route (to 1e-9)",
+          code == 0 and sorted(bq) == sorted(bp) and
+          max(abs(bq[c][j]["value"] - bp[c][j]["value"]) for c in bp for j in range(7)) <= 1e-9, err)
+    q = write("nolocation.qif", qif(ev_p, drop_location=True))
+    code, out, err = run("evaluate", q, "--format", "qif", "--manifest", PLAN, "--out", f"{W}/noloc")
+    check("refused: a QIF sphere without its measured Location, with its line",
+          code == 1 and f"{q}:7:" in err and "sphere 'S2' has no measured Location" in err, err)
+
+    code, out, err = run("evaluate", q, "--format", "dmis", "--manifest", PLAN, "--out", f"{W}/dmis")
+    check("refused: --format dmis for a sphere artifact (a DMIS output is one run), naming what it takes",
+          code == 1 and "features or qif (sphere centres a CMM reports)" in err, err)
 
     # --- the fallback when no u is stated: the specification through the planned points, 1/sqrt(n)
     def centre_term(ev):
