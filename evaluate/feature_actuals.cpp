@@ -187,9 +187,12 @@ SphereCentresFromFeatures sphereCentresFromFeatures(const std::vector<FeatureAct
         return "the rows at lines " + line(*fs[a]) + " ('" + fs[a]->id + "') and " + line(*fs[b]) + " ('" + fs[b]->id + "')";
       };
       if (fs.size() > free.size()) {
-        if (free.empty())
+        if (free.empty()) {
+          const auto& named = out.by_cycle[cycle].at(places[p][0]).feature;
           throw InputError(fs[0]->file, fs[0]->line, "cycle " + std::to_string(cycle) + ": sphere '" + fs[0]->id + "' matches S" +
-                                                         std::to_string(places[p][0]) + ", which another row names by its id");
+                                                         std::to_string(places[p][0]) + ", which the row at line " + line(named) +
+                                                         " ('" + named.id + "') names by its id");
+        }
         throw InputError(fs[1]->file, fs[1]->line, "cycle " + std::to_string(cycle) + ": " + both(0, 1) + " both match S" +
                                                        std::to_string(free[0]) + " by their centres: name them by their ids");
       }
