@@ -25,6 +25,14 @@ double throughFit(const Eigen::MatrixXd& W, int j, const CycleBudgetInput& c, do
   return std::sqrt(std::max(v, 0.0)) * sigma_mm;
 }
 
+// Standard deviation of W_j . centres when each centre coordinate has its own u (independent).
+double throughStated(const Eigen::MatrixXd& W, int j, const std::vector<Eigen::Vector3d>& u_mm) {
+  double v = 0;
+  for (std::size_t k = 0; k < u_mm.size(); ++k)
+    for (int a = 0; a < 3; ++a) v += std::pow(W(j, 3 * static_cast<Eigen::Index>(k) + a) * u_mm[k](a), 2);
+  return std::sqrt(v);
+}
+
 // Standard deviation of W_j . (t, t, ..., t) for a translation t with sigma per axis.
 double throughTranslation(const Eigen::MatrixXd& W, int j, double sigma_mm) {
   double v = 0;
@@ -67,6 +75,7 @@ std::array<uncertainty::Budget, 7> locationErrorBudgets(const LocationLeastSquar
                                                : "";
   const double q = m.coordinate_resolution_mm;
   const double atc = m.probe_tool_change_repeatability_2sigma_um / 2 * 1e-3;
+  const bool features = !c.stated_u_mm.empty();
   for (int j = 0; j < 7; ++j) {
     std::vector<Contribution> cs;
     auto add = [&](std::string input, char type, std::string dist, std::string basis, double u,
@@ -77,7 +86,18 @@ std::array<uncertainty::Budget, 7> locationErrorBudgets(const LocationLeastSquar
     // contribution each (a type A s enters once with its dof, not twice).
     const double v_fit = std::pow(throughFit(W, j, c, 1.0), 2) + std::pow(throughFit(W, j, ref, 1.0), 2);
     const std::string both = ", this and the reference cycle";
-    if (use_a) {
+    if (features) {
+      // No points: each centre's stated u (or the fallback) instead of scatter and resolution.
+      for (int which = 0; which < 2; ++which) {
+        const auto& cc = which ? ref : c;
+        add(std::string("sphere centres as the feature file states them") + (which ? ", reference cycle" : ", this cycle"), 'B',
+            "normal", cc.stated_basis, throughStated(W, j, cc.stated_u_mm));
+      }
+      add("probe point scatter (type A)" + both, 'A', "normal",
+          "not available: the feature file holds no points (no free-radius fit, no pooled residual to check the "
+          "specification against)",
+          0);
+    } else if (use_a) {
       add("probe point scatter (type A)" + both, 'A', "normal", pooled, sigma * std::sqrt(v_fit), ps.type_a_dof);
       add("probe repeatability (specification)" + both, 'B', "normal",
           spec + "; not added: the type A estimate of the same scatter is larger", 0);
@@ -87,8 +107,9 @@ std::array<uncertainty::Budget, 7> locationErrorBudgets(const LocationLeastSquar
         add("probe point scatter (type A)" + both, 'A', "normal", pooled + "; not added: the specification is larger", 0,
             ps.type_a_dof);
     }
-    add("coordinate resolution" + both, 'B', "rectangular", "q = " + num(q * 1e3) + " um per coordinate, q/sqrt(12)",
-        q / std::sqrt(12.0) * std::sqrt(v_fit));
+    if (!features)
+      add("coordinate resolution" + both, 'B', "rectangular", "q = " + num(q * 1e3) + " um per coordinate, q/sqrt(12)",
+          q / std::sqrt(12.0) * std::sqrt(v_fit));
     for (int which = 0; which < 2; ++which) {
       const std::string cyc = which ? ", reference cycle" : ", this cycle";
       if (m.tool_change_each_cycle) {
@@ -115,8 +136,17 @@ std::array<uncertainty::Budget, 7> locationErrorBudgets(const LocationLeastSquar
     } else {
       add("drift during the cycle", 'B', "rectangular", "one complete cycle only: no rate to estimate it", 0);
     }
-    add("sphere form error", 'B', "rectangular",
-        "form " + num(m.sphere_form_error_um) + " um; cancels: the same sphere points are probed in every cycle", 0);
+    if (features)
+      for (int which = 0; which < 2; ++which) {
+        const auto& cc = which ? ref : c;
+        std::vector<Eigen::Vector3d> f;
+        for (double x : cc.form_u_mm) f.push_back(Eigen::Vector3d::Constant(x));
+        add(std::string("sphere form error") + (which ? ", reference cycle" : ", this cycle"), 'B', "rectangular", cc.form_basis,
+            throughStated(W, j, f));
+      }
+    else
+      add("sphere form error", 'B', "rectangular",
+          "form " + num(m.sphere_form_error_um) + " um; cancels: the same sphere points are probed in every cycle", 0);
     if (j == 2) {
       const double h = m.sphere_centre_height_mm, a = m.artifact_alpha_um_per_m_K,
                    dT = m.artifact_temperature_change_half_width_K;
@@ -170,6 +200,52 @@ std::array<uncertainty::Budget, 3> sphereCentreBudgets(const parts::PlanManifest
     if (m.tool_change_each_cycle && std::isfinite(m.probe_tool_change_repeatability_2sigma_um))
       cs.push_back({"tool-change repeatability", 'B', "normal", "probe.tool_change_repeatability_2sigma = " + num(m.probe_tool_change_repeatability_2sigma_um) + " um",
                     m.probe_tool_change_repeatability_2sigma_um / 2, std::numeric_limits<double>::infinity()});
+    out[static_cast<std::size_t>(a)] = uncertainty::combine(std::string("centre ") + axis[a], "um", centre(a) * 1e3, cs, k);
+  }
+  return out;
+}
+
+FeatureCentreU featureCentreU(const parts::PlanManifest& m, const FeatureActual& f, int position) {
+  FeatureCentreU u;
+  if (f.u_um) {
+    u.u_mm = *f.u_um * 1e-3;
+    u.stated = true;
+  } else {
+    const int per = m.pointsPerSphere();
+    std::vector<Eigen::Vector3d> pts;
+    for (int i = 0; i < per; ++i) pts.push_back(m.points[static_cast<std::size_t>((position - 1) * per + i)].contact_mm);
+    geometry::SphereFitOptions fo;
+    fo.fixed_radius_mm = m.sphere_radius_mm + m.tip_radius_mm;
+    const Eigen::Matrix3d cov = geometry::fitSphere(pts, fo).covariance_unscaled.topLeftCorner<3, 3>();
+    const double sigma = m.probe_repeatability_2sigma_um / 2 * 1e-3;
+    const int n = f.n_points > 0 ? f.n_points : per;  // not stated: the planned points
+    for (int a = 0; a < 3; ++a) u.u_mm(a) = sigma * std::sqrt(std::max(cov(a, a), 0.0) * per / n);
+  }
+  u.form_stated = std::isfinite(f.form_um);
+  u.form_u_mm = (u.form_stated ? f.form_um : m.sphere_form_error_um) * 1e-3 / 2 / std::sqrt(3.0);
+  return u;
+}
+
+std::array<uncertainty::Budget, 3> featureCentreBudgets(const parts::PlanManifest& m, const Eigen::Vector3d& centre,
+                                                        const FeatureCentreU& u, double k) {
+  std::array<uncertainty::Budget, 3> out;
+  const char* axis[3] = {"x", "y", "z"};
+  const double inf = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    std::vector<Contribution> cs;
+    cs.push_back({"sphere centre as the feature file states it", 'B', "normal",
+                  u.stated ? std::string("u_") + axis[a] + "_um of the file"
+                           : "not stated: probe.repeatability_2sigma = " + num(m.probe_repeatability_2sigma_um) +
+                                 " um through the planned points' fit, scaled to the file's n_points",
+                  u.u_mm(a) * 1e3, inf});
+    cs.push_back({"probe point scatter (type A)", 'A', "normal", "not available: the feature file holds no points", 0, inf});
+    cs.push_back({"sphere form error", 'B', "rectangular",
+                  (u.form_stated ? "form_um of the file" : "not stated in the file: the artifact's " + num(m.sphere_form_error_um) + " um") +
+                      std::string(", +-form/2 on the centre"),
+                  u.form_u_mm * 1e3, inf});
+    if (m.tool_change_each_cycle && std::isfinite(m.probe_tool_change_repeatability_2sigma_um))
+      cs.push_back({"tool-change repeatability", 'B', "normal", "probe.tool_change_repeatability_2sigma = " + num(m.probe_tool_change_repeatability_2sigma_um) + " um",
+                    m.probe_tool_change_repeatability_2sigma_um / 2, inf});
     out[static_cast<std::size_t>(a)] = uncertainty::combine(std::string("centre ") + axis[a], "um", centre(a) * 1e3, cs, k);
   }
   return out;

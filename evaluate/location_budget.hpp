@@ -25,6 +25,7 @@
 #include <array>
 #include <vector>
 
+#include "evaluate/feature_actuals.hpp"
 #include "evaluate/location_errors.hpp"
 #include "parts/plan_manifest.hpp"
 #include "uncertainty/budget.hpp"
@@ -36,7 +37,31 @@ struct CycleBudgetInput {
   std::vector<double> tau_s;                         // mean time of the position - cycle mean time
   std::array<double, 7> rate_per_s{};                // d(error)/dt, error unit per s
   bool rate_known = false;
+  // Centres read from a feature file (no points; evaluate/feature_actuals.hpp): per position
+  // the standard uncertainty of each coordinate and of the form term (mm), with their bases.
+  // Empty on the point route; when set, they replace the point scatter and resolution terms
+  // (carried through W like them), and the form term no longer cancels.
+  std::vector<Eigen::Vector3d> stated_u_mm;
+  std::vector<double> form_u_mm;
+  std::string stated_basis, form_basis;
 };
+
+// What a feature row states about its centre: u per coordinate from u_x/u_y/u_z_um when the
+// file has them, else the fallback: the probe's specified repeatability through the planned
+// points' known-radius fit of that position (its (J^T J)^-1), scaled to the file's n_points
+// (the point route's type B term when the CMM probed the planned points). The form term:
+// form_um (or, not stated, the artifact's sphere form error), rectangular within +-form/2 on
+// each coordinate of the centre.
+struct FeatureCentreU {
+  Eigen::Vector3d u_mm = Eigen::Vector3d::Zero();
+  bool stated = false;
+  double form_u_mm = 0;
+  bool form_stated = false;
+};
+FeatureCentreU featureCentreU(const parts::PlanManifest& m, const FeatureActual& f, int position);
+// The centre's own budget (x, y, z in um) for evaluation.json, as sphereCentreBudgets.
+std::array<uncertainty::Budget, 3> featureCentreBudgets(const parts::PlanManifest& m, const Eigen::Vector3d& centre_mm,
+                                                        const FeatureCentreU& u, double k = 2.0);
 
 struct PointScatter {
   double type_b_sigma_mm = 0;  // specification

@@ -47,6 +47,9 @@ std::string evaluationJson(const CampaignEvaluation& e, const parts::PlanManifes
   j["kind"] = "sphere_artifact";
   j["manifest"] = e.manifest_file;
   j["points_file"] = e.points_file;
+  if (e.from_features)
+    j["centres_from"] = {{"source", "feature actuals (docs/formats.md#feature-actuals-csv): no points, no fits"},
+                         {"rows_of_other_kinds_not_used", e.other_features}};
   j["reference_cycle"] = e.reference_cycle;
   j["d_m"] = 2.0 * m.radius_from_axis_mm * 1e-3;
   j["least_squares_positions"] = e.ls_positions;
@@ -81,7 +84,7 @@ std::string evaluationJson(const CampaignEvaluation& e, const parts::PlanManifes
       ordered_json js;
       js["position"] = s.position;
       js["points"] = s.points;
-      js["centre_used"] = s.use_free_radius ? "free_radius" : "known_radius";
+      js["centre_used"] = s.stated ? "feature_file" : s.use_free_radius ? "free_radius" : "known_radius";
       js["centre_mm"] = vec(s.centre_mm());
       js["centre_U_um"] = {s.centre_budgets[0].U, s.centre_budgets[1].U, s.centre_budgets[2].U};
       for (const auto& b : s.centre_budgets) {
@@ -90,6 +93,17 @@ std::string evaluationJson(const CampaignEvaluation& e, const parts::PlanManifes
           jb["contributions"].push_back({{"input", ct.input}, {"type", std::string(1, ct.type)}, {"distribution", ct.distribution},
                                          {"basis", ct.basis}, {"u", ct.u}});
         js["centre_budgets"].push_back(jb);
+      }
+      if (s.stated) {
+        const auto& f = s.stated->feature;
+        js["feature"] = {{"id", f.id},
+                         {"line", f.line},
+                         {"matched_by", s.stated->by_id ? "id" : "nearest nominal centre"},
+                         {"diameter_mm", finiteOrNull(f.size_mm)},
+                         {"form_um", finiteOrNull(f.form_um)},
+                         {"n_points", f.n_points}};
+        jc["spheres"].push_back(js);
+        continue;
       }
       js["known_radius_mm"] = s.known_radius.radius_mm;
       js["known_radius_rms_um"] = s.known_radius.rms_mm * 1e3;
@@ -119,6 +133,10 @@ std::string evaluationReport(const CampaignEvaluation& e, const parts::PlanManif
   for (int p : e.ls_positions) o << " " << p;
   o << "; d/2 = " << formatNumber(m.radius_from_axis_mm) << " mm). U is the expanded uncertainty (k = "
     << formatNumber(e.cycles.empty() ? 2.0 : e.cycles.front().budgets[0].k) << ").\n\n";
+  if (e.from_features)
+    o << "Sphere centres as the feature file states them (no points): each centre's budget is the file's stated u per "
+         "coordinate (or the probe's specification through the planned points, scaled to n_points) and its form; the "
+         "point route's pooled type A scatter and free-radius fits are not available (docs/uncertainty.md#sphere-centres-from-feature-actuals).\n\n";
   o << "Probe point scatter: specification sigma = " << formatNumber(e.point_scatter.type_b_sigma_mm * 1e3, 4)
     << " um, pooled fit residual s = " << formatNumber(e.point_scatter.type_a_sigma_mm * 1e3, 4) << " um (nu = "
     << formatNumber(e.point_scatter.type_a_dof) << "); the budgets use the larger.\n\n";

@@ -12,6 +12,9 @@
 #include "evaluate/qif_results.hpp"
 #include "core/csv.hpp"
 #include "core/error.hpp"
+#include "core/input_file.hpp"
+#include "evaluate/feature_actuals.hpp"
+#include "interop/qif.hpp"
 #include "evaluate/ingest.hpp"
 #include "evaluate/ttp_ingest.hpp"
 
@@ -39,16 +42,35 @@ void appendf(std::string& out, const char* fmt, ...) {
 EvaluationFiles sphere(const parts::PlanManifest& planned, const EvaluateRequest& r) {
   parts::PlanManifest m = planned;
   if (!r.cycle_starts.empty()) applyCycleStarts(m, r.cycle_starts);
-  const auto records = readProbeRecords(r.input_file, parsePointsFormat(r.format), m);
   EvaluateOptions opt;
   opt.known_radius = !r.free_radius;
   EvaluationFiles f;
-  f.sphere = evaluateSphereCampaign(m, records, opt);
+  std::string text;
+  // auto: a CSV with the feature-actuals columns is one (the points CSV has none of i,j,k,n_points).
+  if (r.format == "features" || (r.format == "auto" && std::filesystem::is_regular_file(r.input_file))) text = readFile(r.input_file);
+  if (r.format == "features" || (r.format == "auto" && looksLikeFeatureActuals(text))) {
+    // Only the fitted centres, no points (issue 34): the same location errors from them.
+    const auto rows = parseFeatureActuals(text, r.input_file, m.cycles);
+    f.sphere = evaluateSphereCampaignFromFeatures(m, sphereCentresFromFeatures(rows, m), r.input_file, opt);
+  } else if (r.format == "qif") {
+    // The measured sphere features of a QIF 3.0 Results file, one MeasurementResults per cycle.
+    // (A DMIS output holds one run: a campaign's cycles cannot be told apart in it; not read yet.)
+    const auto doc = interop::parseQifResults(readFile(r.input_file), r.input_file);
+    f.sphere = evaluateSphereCampaignFromFeatures(m, sphereCentresFromFeatures(featureActualsFromCmm(doc, m.cycles), m), r.input_file, opt);
+  } else {
+    if (r.format != "auto" && r.format != "linuxcnc" && r.format != "fanuc" && r.format != "csv")
+      throw InputError("", 0, "--format '" + r.format + "': a sphere-artifact campaign takes auto, linuxcnc, fanuc, csv (points), "
+                              "features or qif (sphere centres a CMM reports)");
+    f.sphere = evaluateSphereCampaign(m, readProbeRecords(r.input_file, parsePointsFormat(r.format), m), opt);
+  }
   const auto& e = *f.sphere;
   f.errors_csv = errorSeriesCsv(e);
   f.evaluation_json = evaluationJson(e, m);
   f.report_md = evaluationReport(e, m);
   f.stdout_text = sphereEvaluationStdout(e, r.out_dir);
+  if (e.from_features)
+    f.stdout_text = "Sphere centres from the feature file " + r.input_file + " (no points; " + std::to_string(e.other_features) +
+                    " rows of other kinds not used)\n" + f.stdout_text;
   f.results_qif = evaluationQif(m, nullptr, f.errors_csv);
   if (m.tilt_axis) {
     // The tilting axis and C together on the machine's chain (issue 33), beside seed 004's

@@ -42,6 +42,9 @@ std::vector<Vector3d> centresOf(const CycleEvaluation& c, const std::vector<int>
   return out;
 }
 
+void evaluateLocationErrors(const parts::PlanManifest& m, const Layout& layout, CampaignEvaluation& out,
+                            const EvaluateOptions& opt);
+
 }  // namespace
 
 std::vector<ScatterTerm> scatterTerms(const CycleEvaluation& c) {
@@ -62,7 +65,6 @@ CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& m,
   out.ls_positions = layout.ls_positions;
   out.formula_positions = layout.formula_positions;
   out.formulas_applicable = layout.formulas;
-  const LocationLeastSquares ls(layout.ls_angles, m.radius_from_axis_mm);
   const double known_radius = m.sphere_radius_mm + m.tip_radius_mm;
 
   // Group by cycle and position.
@@ -129,6 +131,17 @@ CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& m,
     ce.time_s = t_n ? t_sum / t_n : m.cycle_start_s[cyc - 1];
     out.cycles.push_back(std::move(ce));
   }
+  evaluateLocationErrors(m, layout, out, opt);
+  return out;
+}
+
+namespace {
+
+// The location-error part both centre sources share: the reference cycle, the pooled scatter,
+// the estimators and every budget, from the cycles' centres.
+void evaluateLocationErrors(const parts::PlanManifest& m, const Layout& layout, CampaignEvaluation& out,
+                            const EvaluateOptions& opt) {
+  const LocationLeastSquares ls(layout.ls_angles, m.radius_from_axis_mm);
   if (out.cycles.empty())
     throw InputError(out.points_file, 0, "no complete cycle: nothing to evaluate");
   out.reference_cycle = out.cycles.front().cycle;
@@ -167,7 +180,8 @@ CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& m,
 
   for (auto& c : out.cycles) {
     for (auto& s : c.spheres)
-      s.centre_budgets = sphereCentreBudgets(m, s.centre_mm(), s.centre_cov_unscaled(), out.point_scatter, opt.coverage_k);
+      s.centre_budgets = s.stated ? featureCentreBudgets(m, s.centre_mm(), s.stated_u, opt.coverage_k)
+                                  : sphereCentreBudgets(m, s.centre_mm(), s.centre_cov_unscaled(), out.point_scatter, opt.coverage_k);
     const auto centres = centresOf(c, layout.ls_positions);
     c.least_squares = ls.solve(centres, ref_centres);
     const auto res = ls.residual(centres, ref_centres);
@@ -195,10 +209,28 @@ CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& m,
   for (std::size_t i = 0; i < n_cycles; ++i) {
     const auto& c = out.cycles[i];
     auto& in = inputs[i];
+    std::size_t n_stated = 0, n_form = 0;
     for (int p : layout.ls_positions) {
       const auto& s = c.spheres[static_cast<std::size_t>(p - 1)];
       in.centre_cov_unscaled.push_back(s.centre_cov_unscaled());
       in.tau_s.push_back(s.time_s - c.time_s);
+      if (s.stated) {
+        in.stated_u_mm.push_back(s.stated_u.u_mm);
+        in.form_u_mm.push_back(s.stated_u.form_u_mm);
+        n_stated += s.stated_u.stated;
+        n_form += s.stated_u.form_stated;
+      }
+    }
+    if (!in.stated_u_mm.empty()) {
+      const auto n = std::to_string(in.stated_u_mm.size());
+      in.stated_basis = "u_x/u_y/u_z_um of the file for " + std::to_string(n_stated) + " of the " + n + " centres" +
+                        (n_stated < in.stated_u_mm.size()
+                             ? "; the others not stated: probe.repeatability_2sigma = " + formatSignificant4(m.probe_repeatability_2sigma_um) +
+                                   " um through the planned points' fit, scaled to n_points"
+                             : std::string());
+      in.form_basis = "form_um of the file for " + std::to_string(n_form) + " of the " + n + " centres" +
+                      (n_form < in.stated_u_mm.size() ? "; the others the artifact's " + formatSignificant4(m.sphere_form_error_um) + " um" : std::string()) +
+                      ", +-form/2 on each coordinate; does not cancel: the file does not say that the same points were probed";
     }
     if (n_cycles >= 2) {
       const std::size_t lo = i == 0 ? 0 : i - 1, hi = i + 1 == n_cycles ? i : i + 1;
@@ -230,6 +262,69 @@ CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& m,
       for (const auto& c : out.cycles) cs.push_back(c.spheres[static_cast<std::size_t>(s.position - 1)].centre_mm());
       out.centre_repeatability.push_back({s.position, centreRepeatability(cs)});
     }
+}
+
+}  // namespace
+
+CampaignEvaluation evaluateSphereCampaignFromFeatures(const parts::PlanManifest& m, const SphereCentresFromFeatures& centres,
+                                                      const std::string& file, const EvaluateOptions& opt) {
+  if (!opt.known_radius) throw InputError(file, 0, "--free-radius: sphere centres read from a feature file come from no fit of ours");
+  CampaignEvaluation out;
+  out.manifest_file = m.file;
+  out.points_file = file;
+  out.from_features = true;
+  out.other_features = centres.other_kinds;
+  const Layout layout = layoutOf(m);
+  out.ls_positions = layout.ls_positions;
+  out.formula_positions = layout.formula_positions;
+  out.formulas_applicable = layout.formulas;
+  const int per = m.pointsPerSphere();
+  for (int cyc = 1; cyc <= m.cycles; ++cyc) {
+    const auto it = centres.by_cycle.find(cyc);
+    if (it == centres.by_cycle.end()) {
+      out.incomplete.push_back({cyc, "no sphere centres in the feature file"});
+      continue;
+    }
+    CycleEvaluation ce;
+    ce.cycle = cyc;
+    std::string missing;
+    double t_sum = 0, n_sum = 0;
+    for (const auto& s : m.spheres) {
+      const auto pit = it->second.find(s.position);
+      if (pit == it->second.end()) {
+        missing += (missing.empty() ? "" : ", ") + std::string("position ") + std::to_string(s.position) +
+                   " has no sphere centre in the feature file";
+        continue;
+      }
+      const FeatureActual& f = pit->second.feature;
+      SphereMeasurement sm;
+      sm.position = s.position;
+      const int n_points = f.n_points > 0 ? f.n_points : per;  // not stated: as planned
+      sm.points = n_points;
+      if (f.time_s) {
+        sm.time_s = *f.time_s;
+      } else {
+        if (std::isnan(m.cycle_start_s[cyc - 1]))
+          throw InputError(f.file, f.line, "cycle " + std::to_string(cyc) +
+                                               ": no start time (the --cycle-starts file ends before it) and no time_s of its own");
+        double t = 0;
+        for (int i = 0; i < per; ++i) t += m.points[static_cast<std::size_t>((s.position - 1) * per + i)].time_in_cycle_s;
+        sm.time_s = m.cycle_start_s[cyc - 1] + t / per;
+      }
+      t_sum += sm.time_s * n_points;
+      n_sum += n_points;
+      sm.stated = pit->second;
+      sm.stated_u = featureCentreU(m, f, s.position);
+      ce.spheres.push_back(std::move(sm));
+    }
+    if (!missing.empty()) {
+      out.incomplete.push_back({cyc, missing});
+      continue;
+    }
+    ce.time_s = t_sum / n_sum;
+    out.cycles.push_back(std::move(ce));
+  }
+  evaluateLocationErrors(m, layout, out, opt);
   return out;
 }
 

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "evaluate/feature_actuals.hpp"
 #include "evaluate/ingest.hpp"
 #include "evaluate/location_budget.hpp"
 #include "geometry/location_errors.hpp"
@@ -53,10 +54,13 @@ struct SphereMeasurement {
   std::optional<geometry::SphereFit> free_radius;  // absent when not determinable
   std::string free_radius_note;
   bool use_free_radius = false;  // --free-radius: centres from the free fit
+  // The centre read from a feature file instead of a fit (the fits above are then empty).
+  std::optional<StatedCentre> stated;
+  FeatureCentreU stated_u;
   const geometry::SphereFit& used() const { return use_free_radius ? *free_radius : known_radius; }
-  Eigen::Vector3d centre_mm() const { return used().centre_mm; }
+  Eigen::Vector3d centre_mm() const { return stated ? stated->feature.location_mm : used().centre_mm; }
   Eigen::Matrix3d centre_cov_unscaled() const {
-    return used().covariance_unscaled.topLeftCorner<3, 3>();
+    return stated ? Eigen::Matrix3d::Zero() : Eigen::Matrix3d(used().covariance_unscaled.topLeftCorner<3, 3>());
   }
 };
 
@@ -78,6 +82,8 @@ struct CycleEvaluation {
 
 struct CampaignEvaluation {
   std::string manifest_file, points_file;
+  bool from_features = false;  // centres read from a feature file (evaluateSphereCampaignFromFeatures)
+  int other_features = 0;      // rows of other kinds in it, not used
   int reference_cycle = 0;
   std::vector<int> ls_positions;          // positions used by least squares
   std::array<int, 4> formula_positions{};  // position of formula index 1..4, 0 if absent
@@ -97,6 +103,15 @@ std::vector<ScatterTerm> scatterTerms(const CycleEvaluation& c);
 CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& manifest,
                                           const std::vector<ProbeRecord>& records,
                                           const EvaluateOptions& options = {});
+
+// The same evaluation from sphere centres a CMM package reports (no points): each position's
+// centre per cycle from `centres` (evaluate/feature_actuals.hpp), its budget from what the file
+// states (location_budget.hpp FeatureCentreU). A position without a centre makes its cycle
+// incomplete, listed as the point route lists a position without points. The time of a centre
+// is its time_s, else the mean planned time of its position's points; the cycle's, their mean
+// weighted by n_points. --free-radius does not apply (there is no fit).
+CampaignEvaluation evaluateSphereCampaignFromFeatures(const parts::PlanManifest& manifest, const SphereCentresFromFeatures& centres,
+                                                      const std::string& file, const EvaluateOptions& options = {});
 
 // Error series CSV (docs/architecture.md#data-contracts): time_s,cycle,<7 errors>,U_<7 errors>.
 std::string errorSeriesCsv(const CampaignEvaluation& e);

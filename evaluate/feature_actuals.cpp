@@ -1,0 +1,216 @@
+#include "evaluate/feature_actuals.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/csv.hpp"
+#include "core/error.hpp"
+
+namespace probeloop::evaluate {
+
+namespace {
+
+const char* kRequired[] = {"cycle", "id", "kind", "x_mm", "y_mm", "z_mm", "i", "j", "k", "size_mm", "form_um", "n_points"};
+const char* kKinds[] = {"sphere", "circle", "cylinder", "plane", "point"};
+
+bool blank(const CsvRow& r, int c) { return c < 0 || c >= static_cast<int>(r.fields.size()) || r.fields[c].empty(); }
+
+std::string line(const FeatureActual& f) { return std::to_string(f.line); }
+
+}  // namespace
+
+bool looksLikeFeatureActuals(const std::string& text) {
+  const auto h = csvHeaderFields(text);
+  for (const char* c : kRequired)
+    if (std::find(h.begin(), h.end(), c) == h.end()) return false;
+  return true;
+}
+
+std::vector<FeatureActual> parseFeatureActuals(const std::string& text, const std::string& file, int max_cycle) {
+  const CsvTable t = parseCsv(text, file);
+  int col[12];
+  for (int i = 0; i < 12; ++i) {
+    col[i] = t.column(kRequired[i]);
+    if (col[i] < 0)
+      throw InputError(file, t.header_line, std::string("missing column '") + kRequired[i] +
+                                                "'; feature actuals need cycle,id,kind,x_mm,y_mm,z_mm,i,j,k,size_mm,form_um,n_points "
+                                                "(docs/formats.md#feature-actuals-csv)");
+  }
+  const int cu[3] = {t.column("u_x_um"), t.column("u_y_um"), t.column("u_z_um")};
+  const int n_u = (cu[0] >= 0) + (cu[1] >= 0) + (cu[2] >= 0);
+  if (n_u != 0 && n_u != 3)
+    throw InputError(file, t.header_line, "the stated uncertainty needs all three columns u_x_um,u_y_um,u_z_um or none");
+  const int c_time = t.column("time_s");
+  std::vector<FeatureActual> out;
+  for (const auto& row : t.rows) {
+    FeatureActual f;
+    f.file = file;
+    f.line = row.line;
+    auto fail = [&](const std::string& field, const std::string& why) { throw InputError(file, row.line, field + ": " + why); };
+    const double cyc = t.number(row, col[0]);
+    if (cyc != std::round(cyc) || cyc < 1) fail("cycle", row.fields[col[0]] + " is not a positive integer");
+    if (max_cycle > 0 && cyc > max_cycle) fail("cycle", row.fields[col[0]] + " is beyond the plan's " + std::to_string(max_cycle) + " cycles");
+    if (cyc > 1e6) fail("cycle", row.fields[col[0]] + " is not a plausible cycle number");
+    f.cycle = static_cast<int>(cyc);
+    f.id = row.fields[col[1]];
+    if (f.id.empty()) fail("id", "empty");
+    f.kind = row.fields[col[2]];
+    std::transform(f.kind.begin(), f.kind.end(), f.kind.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (std::find(std::begin(kKinds), std::end(kKinds), f.kind) == std::end(kKinds))
+      fail("kind", "'" + row.fields[col[2]] + "' is not a feature kind: expected sphere, circle, cylinder, plane or point");
+    f.location_mm = {t.number(row, col[3]), t.number(row, col[4]), t.number(row, col[5])};
+    const bool directed = f.kind == "circle" || f.kind == "cylinder" || f.kind == "plane";
+    if (directed || !(blank(row, col[6]) && blank(row, col[7]) && blank(row, col[8]))) {
+      const Eigen::Vector3d d(t.number(row, col[6]), t.number(row, col[7]), t.number(row, col[8]));
+      if (directed && !(d.norm() > 1e-9)) fail("i,j,k", "a " + f.kind + " needs its axis or normal (zero length)");
+      if (directed) f.direction = d.normalized();
+    }
+    const bool sized = f.kind == "sphere" || f.kind == "circle" || f.kind == "cylinder";
+    f.size_mm = NAN;
+    if (sized || !blank(row, col[9])) {
+      f.size_mm = t.number(row, col[9]);
+      if (!(f.size_mm > 0)) fail("size_mm", row.fields[col[9]] + ": a diameter must be positive");
+    }
+    f.form_um = NAN;
+    if (!blank(row, col[10])) {
+      f.form_um = t.number(row, col[10]);
+      if (f.form_um < 0) fail("form_um", row.fields[col[10]] + " is negative");
+    }
+    const double n = t.number(row, col[11]);
+    if (n != std::round(n) || n < 1 || n > 1e9) fail("n_points", row.fields[col[11]] + " is not a positive integer");
+    f.n_points = static_cast<int>(n);
+    const int n_blank = n_u == 3 ? blank(row, cu[0]) + blank(row, cu[1]) + blank(row, cu[2]) : 3;
+    if (n_blank != 0 && n_blank != 3) fail("u_x_um,u_y_um,u_z_um", "all three or none (this row's location has no stated u)");
+    if (n_blank == 0) {
+      Eigen::Vector3d u;
+      for (int a = 0; a < 3; ++a) {
+        u(a) = t.number(row, cu[a]);
+        if (u(a) < 0) fail(t.header[cu[a]], row.fields[cu[a]] + " is negative");
+      }
+      f.u_um = u;
+    }
+    if (!blank(row, c_time)) f.time_s = t.number(row, c_time);
+    out.push_back(std::move(f));
+  }
+  if (out.empty()) throw InputError(file, t.header_line, "no features in the file: nothing to evaluate");
+  return out;
+}
+
+std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, int max_cycle) {
+  std::vector<FeatureActual> out;
+  for (const auto& c : d.features) {
+    FeatureActual f;
+    f.file = d.file;
+    f.line = c.line;
+    f.cycle = std::max(c.run, 1);
+    f.id = c.name;
+    f.kind = interop::cmmFeatureKindName(c.kind);
+    if (c.kind == interop::CmmFeatureKind::Sphere && !c.measured.given)
+      throw InputError(d.file, c.line, "sphere '" + c.name + "' has no measured Location (points only): the sphere artifact is "
+                                       "evaluated here from the centres the CMM reports");
+    if (max_cycle > 0 && f.cycle > max_cycle)
+      throw InputError(d.file, c.line, "measurement run " + std::to_string(f.cycle) + " (a cycle) is beyond the plan's " +
+                                           std::to_string(max_cycle) + " cycles");
+    f.location_mm = c.measured.location_mm;
+    f.direction = c.measured.direction;
+    f.size_mm = c.measured.diameter_mm;
+    f.form_um = c.measured.form_mm * 1e3;
+    f.n_points = static_cast<int>(std::min<std::size_t>(c.points.size(), 1000000000));
+    out.push_back(std::move(f));
+  }
+  if (out.empty()) throw InputError(d.file, 0, "no measured features in the file: nothing to evaluate");
+  return out;
+}
+
+SphereCentresFromFeatures sphereCentresFromFeatures(const std::vector<FeatureActual>& rows, const parts::PlanManifest& m) {
+  constexpr double kNear_mm = 5.0, kDiameter_mm = 1.0;
+  SphereCentresFromFeatures out;
+  // The places: positions whose nominal centres coincide (a repeat) share one.
+  std::vector<int> place_of(m.spheres.size());
+  std::vector<std::vector<int>> places;
+  for (std::size_t i = 0; i < m.spheres.size(); ++i) {
+    std::size_t p = 0;
+    while (p < places.size() &&
+           (m.spheres[static_cast<std::size_t>(places[p][0] - 1)].nominal_centre_mm - m.spheres[i].nominal_centre_mm).norm() > 1e-6)
+      ++p;
+    if (p == places.size()) places.push_back({});
+    places[p].push_back(m.spheres[i].position);
+    place_of[i] = static_cast<int>(p);
+  }
+  std::map<int, std::map<std::size_t, std::vector<const FeatureActual*>>> foreign;  // cycle -> place -> rows
+  auto claim = [&](const FeatureActual& f, int position, bool by_id) {
+    auto& cyc = out.by_cycle[f.cycle];
+    const auto it = cyc.find(position);
+    if (it != cyc.end())
+      throw InputError(f.file, f.line, "cycle " + std::to_string(f.cycle) + ": position " + std::to_string(position) +
+                                           " is given twice, by the rows at lines " + line(it->second.feature) + " ('" +
+                                           it->second.feature.id + "') and " + line(f) + " ('" + f.id + "')");
+    cyc[position] = {f, position, by_id};
+  };
+  for (const auto& f : rows) {
+    if (f.kind != "sphere") {
+      ++out.other_kinds;
+      continue;
+    }
+    if (std::isfinite(f.size_mm) && std::fabs(f.size_mm / 2 - m.sphere_radius_mm) > kDiameter_mm / 2)
+      throw InputError(f.file, f.line, "size_mm: a diameter of " + formatNumber(f.size_mm) + " mm is not the artifact's sphere (" +
+                                           formatNumber(2 * m.sphere_radius_mm) + " mm, within " + formatNumber(kDiameter_mm) + " mm)");
+    const auto s = std::find_if(m.spheres.begin(), m.spheres.end(), [&](const auto& x) { return x.id == f.id; });
+    if (s != m.spheres.end()) {
+      claim(f, s->position, true);
+      continue;
+    }
+    std::vector<std::size_t> near;
+    double nearest = INFINITY;
+    int nearest_pos = 0;
+    for (std::size_t p = 0; p < places.size(); ++p) {
+      const double d = (m.spheres[static_cast<std::size_t>(places[p][0] - 1)].nominal_centre_mm - f.location_mm).norm();
+      if (d < nearest) nearest = d, nearest_pos = places[p][0];
+      if (d <= kNear_mm) near.push_back(p);
+    }
+    if (near.empty())
+      throw InputError(f.file, f.line, "sphere '" + f.id + "' is " + formatNumber(nearest, 3) + " mm from the nearest planned centre (S" +
+                                           std::to_string(nearest_pos) + "); a foreign id needs its centre within " +
+                                           formatNumber(kNear_mm) + " mm of one");
+    if (near.size() > 1)
+      throw InputError(f.file, f.line, "sphere '" + f.id + "' lies within " + formatNumber(kNear_mm) + " mm of both S" +
+                                           std::to_string(places[near[0]][0]) + " and S" + std::to_string(places[near[1]][0]) +
+                                           ": name it by its id");
+    foreign[f.cycle][near[0]].push_back(&f);
+  }
+  for (auto& [cycle, by_place] : foreign)
+    for (auto& [p, fs] : by_place) {
+      std::vector<int> free;
+      for (int pos : places[p])
+        if (!out.by_cycle[cycle].count(pos)) free.push_back(pos);
+      auto both = [&](std::size_t a, std::size_t b) {
+        return "the rows at lines " + line(*fs[a]) + " ('" + fs[a]->id + "') and " + line(*fs[b]) + " ('" + fs[b]->id + "')";
+      };
+      if (fs.size() > free.size()) {
+        if (free.empty()) {
+          const auto& named = out.by_cycle[cycle].at(places[p][0]).feature;
+          throw InputError(fs[0]->file, fs[0]->line, "cycle " + std::to_string(cycle) + ": sphere '" + fs[0]->id + "' matches S" +
+                                                         std::to_string(places[p][0]) + ", which the row at line " + line(named) +
+                                                         " ('" + named.id + "') names by its id");
+        }
+        throw InputError(fs[1]->file, fs[1]->line, "cycle " + std::to_string(cycle) + ": " + both(0, 1) + " both match S" +
+                                                       std::to_string(free[0]) + " by their centres: name them by their ids");
+      }
+      if (free.size() > 1) {  // a repeat: the same place at several times of the cycle
+        const auto& f = *fs[0];
+        if (fs.size() < free.size() || std::any_of(fs.begin(), fs.end(), [](const FeatureActual* x) { return !x->time_s; }))
+          throw InputError(f.file, f.line, "cycle " + std::to_string(cycle) + ": " + (fs.size() > 1 ? both(0, 1) + " both match S" : "sphere '" + f.id + "' matches S") +
+                                               std::to_string(free[0]) + " and S" + std::to_string(free[1]) +
+                                               " (the same place, probed twice): give the ids or time_s for each");
+        std::stable_sort(fs.begin(), fs.end(), [](const FeatureActual* a, const FeatureActual* b) { return *a->time_s < *b->time_s; });
+        for (std::size_t i = 1; i < fs.size(); ++i)
+          if (*fs[i]->time_s == *fs[i - 1]->time_s)
+            throw InputError(fs[i]->file, fs[i]->line, "cycle " + std::to_string(cycle) + ": " + both(i - 1, i) +
+                                                           " match the same place at the same time_s: name them by their ids");
+      }
+      for (std::size_t i = 0; i < fs.size(); ++i) claim(*fs[i], free[i], false);
+    }
+  return out;
+}
+
+}  // namespace probeloop::evaluate
