@@ -11,6 +11,7 @@
 #include "core/error.hpp"
 #include "core/units.hpp"
 #include "geometry/kinematic_chain.hpp"
+#include "geometry/segment_distance.hpp"
 #include "sim/virtual_machine_detail.hpp"
 
 namespace probeloop::sim::detail {
@@ -21,30 +22,6 @@ double poly(const std::vector<double>& c, double x) {
   double v = 0;
   for (std::size_t k = c.size(); k-- > 0;) v = v * x + c[k];
   return v;
-}
-
-// Closest distance between segments p0-p1 and q0-q1 (Ericson, Real-Time Collision
-// Detection 5.1.9), with the parameter s on the first segment.
-double segmentDistance(const Vector3d& p0, const Vector3d& p1, const Vector3d& q0, const Vector3d& q1) {
-  const Vector3d d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
-  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
-  double s = 0, t = 0;
-  if (a <= 1e-18 && e <= 1e-18) return r.norm();
-  if (a <= 1e-18) {
-    t = std::clamp(f / e, 0.0, 1.0);
-  } else {
-    const double c = d1.dot(r);
-    if (e <= 1e-18) {
-      s = std::clamp(-c / a, 0.0, 1.0);
-    } else {
-      const double b = d1.dot(d2), den = a * e - b * b;
-      s = den > 1e-18 ? std::clamp((b * f - c * e) / den, 0.0, 1.0) : 0.0;
-      t = (b * s + f) / e;
-      if (t < 0) t = 0, s = std::clamp(-c / a, 0.0, 1.0);
-      else if (t > 1) t = 1, s = std::clamp((b - c) / a, 0.0, 1.0);
-    }
-  }
-  return ((p0 + s * d1) - (q0 + t * d2)).norm();
 }
 
 }  // namespace
@@ -199,7 +176,7 @@ void VirtualMachine::checkStemAndTable(const Vector3d& a, const Vector3d& b, con
   if (art.up != Vector3d::UnitZ()) {
     // A tilted table: the stem along its normal, the tip above its plane.
     const double h = (art.centre - art.table_point).dot(art.up);
-    if (segmentDistance(a, b, art.centre - h * art.up, art.centre - art.radius * art.up) < art.stem_radius + r - 1e-9)
+    if (geometry::segmentDistance(a, b, art.centre - h * art.up, art.centre - art.radius * art.up) < art.stem_radius + r - 1e-9)
       throw SafetyError(what + " would hit the artifact's stem");
     const double above = std::min((a - art.table_point).dot(art.up), (b - art.table_point).dot(art.up));
     if (above - r < -1e-9)
@@ -209,7 +186,7 @@ void VirtualMachine::checkStemAndTable(const Vector3d& a, const Vector3d& b, con
   }
   const Vector3d stem_top(art.centre.x(), art.centre.y(), art.centre.z() - art.radius);
   const Vector3d stem_bottom(art.centre.x(), art.centre.y(), art.table_z);
-  if (segmentDistance(a, b, stem_bottom, stem_top) < art.stem_radius + r - 1e-9)
+  if (geometry::segmentDistance(a, b, stem_bottom, stem_top) < art.stem_radius + r - 1e-9)
     throw SafetyError(what + " would hit the artifact's stem");
   if (std::min(a.z(), b.z()) - r < art.table_z - 1e-9)
     throw SafetyError(what + " would hit the table: tip at Z " + formatNumber(std::min(a.z(), b.z()), 4) +
@@ -237,7 +214,7 @@ void VirtualMachine::checkPath(const MachinePosition& to, const std::string& wha
   // After a trigger the stylus is deflected into the surface by pre-travel, delay and
   // overshoot (< 0.5 mm); a move that leaves from there outward is the retract.
   const bool retract = (a - art.centre).norm() > Rt - 0.5 && (a - art.centre).dot(b - a) >= 0;
-  if (!retract && segmentDistance(a, b, art.centre, art.centre) < Rt - 1e-9)
+  if (!retract && geometry::segmentDistance(a, b, art.centre, art.centre) < Rt - 1e-9)
     throw SafetyError(what + " would pass through the sphere artifact");
   checkStemAndTable(a, b, art, what);
 }

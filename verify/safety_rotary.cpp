@@ -13,38 +13,11 @@
 #include <cmath>
 #include <Eigen/Geometry>
 
+#include "geometry/segment_distance.hpp"
 #include "verify/safety_checker.hpp"
 
 namespace probeloop::verify::detail {
 namespace {
-
-// Closest distance of segments p1-q1 and p2-q2 (Ericson, Real-Time Collision Detection 5.1.9).
-double segmentSegmentDistance(const Vector3d& p1, const Vector3d& q1, const Vector3d& p2, const Vector3d& q2) {
-  const Vector3d d1 = q1 - p1, d2 = q2 - p2, r = p1 - p2;
-  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
-  double s = 0, t = 0;
-  if (a <= 1e-12 && e <= 1e-12) return r.norm();
-  if (a <= 1e-12) {
-    t = std::clamp(f / e, 0.0, 1.0);
-  } else {
-    const double c = d1.dot(r);
-    if (e <= 1e-12) {
-      s = std::clamp(-c / a, 0.0, 1.0);
-    } else {
-      const double b = d1.dot(d2), denom = a * e - b * b;
-      s = denom > 1e-12 ? std::clamp((b * f - c * e) / denom, 0.0, 1.0) : 0.0;
-      t = (b * s + f) / e;
-      if (t < 0) {
-        t = 0;
-        s = std::clamp(-c / a, 0.0, 1.0);
-      } else if (t > 1) {
-        t = 1;
-        s = std::clamp((b - c) / a, 0.0, 1.0);
-      }
-    }
-  }
-  return ((p1 + s * d1) - (p2 + t * d2)).norm();
-}
 
 // Distance of point x from the solid cylinder of radius r along unit u from s0, length L.
 double pointToToolCylinder(const Vector3d& x, const Vector3d& s0, const Vector3d& u, double L, double r) {
@@ -132,7 +105,7 @@ Hit Checker::tiltedDistance(const Tool& tool, const Vector3d& t, double c_deg, d
     for (const auto& s : scene_.spheres) take(pointToToolCylinder(s.c, s0, u, L, p.r) - s.r, p.name, s.name);
     for (const auto& c : cyls) {
       if (cutting && p.cuts && c.name == scene_.material_name) continue;
-      take(segmentSegmentDistance(s0, s1, Vector3d(c.c.x(), c.c.y(), c.z0), Vector3d(c.c.x(), c.c.y(), c.z1)) - p.r - c.r,
+      take(geometry::segmentDistance(s0, s1, Vector3d(c.c.x(), c.c.y(), c.z0), Vector3d(c.c.x(), c.c.y(), c.z1)) - p.r - c.r,
            p.name, c.name);
     }
     // The table: the part's lowest point against the surface, where the part reaches over the disc.
