@@ -96,6 +96,17 @@ void ProgramWalker::checkCTravel(double c, const OpNote& note, const char* what)
                    formatNumber(m_.c.min_deg, 3) + ", " + formatNumber(m_.c.max_deg, 3) + "] of " + m_.file);
 }
 
+void ProgramWalker::tilt(const parts::RotaryAxis& axis, const char* name, double deg, double& now, const OpNote& note) {
+  const std::string n(name);
+  if (!axis.present) fail(note, n + " move on a machine without a" + (n == "A" ? "n " : " ") + n + " axis (" + m_.file + ")");
+  if (!axis.continuous && !(deg >= axis.min_deg - 1e-9 && deg <= axis.max_deg + 1e-9))
+    fail(note, n + " = " + formatNumber(deg, 3) + " deg is outside the " + n + " travel of " + m_.file);
+  const double dt = rotaryIndexSeconds(deg - now, axis);
+  times_.rotary_index_s += dt;
+  t_ += dt;
+  now = deg;
+}
+
 void ProgramWalker::checkLinearFeed(double F, const OpNote& note, const char* what) const {
   const double fmax = std::min({m_.x.max_feed_mm_per_min, m_.y.max_feed_mm_per_min, m_.z.max_feed_mm_per_min});
   if (!(F > 0)) fail(note, std::string(what) + " without a feed rate");
@@ -185,24 +196,8 @@ void ProgramWalker::step(const gcode::Op& op, const OpNote& note) {
             t_ += dt;
             c_ = r.c_deg;
           },
-          [&](const gcode::RotateB& r) {
-            if (!m_.b.present) fail(note, "B move on a machine without a B axis (" + m_.file + ")");
-            if (!m_.b.continuous && !(r.b_deg >= m_.b.min_deg - 1e-9 && r.b_deg <= m_.b.max_deg + 1e-9))
-              fail(note, "B = " + formatNumber(r.b_deg, 3) + " deg is outside the B travel of " + m_.file);
-            const double dt = rotaryIndexSeconds(r.b_deg - b_, m_.b);
-            times_.rotary_index_s += dt;
-            t_ += dt;
-            b_ = r.b_deg;
-          },
-          [&](const gcode::RotateA& r) {
-            if (!m_.a.present) fail(note, "A move on a machine without an A axis (" + m_.file + ")");
-            if (!m_.a.continuous && !(r.a_deg >= m_.a.min_deg - 1e-9 && r.a_deg <= m_.a.max_deg + 1e-9))
-              fail(note, "A = " + formatNumber(r.a_deg, 3) + " deg is outside the A travel of " + m_.file);
-            const double dt = rotaryIndexSeconds(r.a_deg - a_, m_.a);
-            times_.rotary_index_s += dt;
-            t_ += dt;
-            a_ = r.a_deg;
-          },
+          [&](const gcode::RotateB& r) { tilt(m_.b, "B", r.b_deg, b_, note); },
+          [&](const gcode::RotateA& r) { tilt(m_.a, "A", r.a_deg, a_, note); },
           [&](const gcode::ToolChange& tc) {
             if (spindle_rpm_ != 0) fail(note, "tool change T" + std::to_string(tc.tool) + " with the spindle turning (M5 first)");
             if (std::fabs(gauge_.z() - m_.tool_change.z_mm) > 1e-9)

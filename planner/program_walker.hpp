@@ -113,6 +113,8 @@ class ProgramWalker {
   void step(const gcode::Op& op, const OpNote& note);
   void checkTravel(const Eigen::Vector3d& gauge, const OpNote& note, const char* what) const;
   void checkCTravel(double c_deg, const OpNote& note, const char* what) const;
+  // An A or B index: the axis present and the target in its travel, timed; `now` follows it.
+  void tilt(const parts::RotaryAxis& axis, const char* name, double deg, double& now, const OpNote& note);
   void checkLinearFeed(double F, const OpNote& note, const char* what) const;
   void motion(MotionKind kind, const char* what, const Eigen::Vector3d& to_tip, double to_c, const OpNote& note) const;
   [[noreturn]] void fail(const OpNote& note, const std::string& message) const;
