@@ -40,3 +40,25 @@ def run_text_and_json(pl, args, cwd=None):
         with open(os.path.join(cwd or ".", path), "w") as f:
             f.write(q.stdout)
     return q.returncode, p.stdout, p.stderr + q.stderr
+
+
+def cli(pl, workdir):
+    """The two ways the integration tests call the CLI at `pl`: run(*args) returns (returncode,
+    stdout, stderr); must(*args) returns stdout, or prints the failure, removes `workdir` and
+    ends the test with exit 1 when the command fails (a step others depend on)."""
+    import shutil
+    import subprocess
+
+    def run(*args):
+        p = subprocess.run([pl, *args], capture_output=True, text=True)
+        return p.returncode, p.stdout, p.stderr
+
+    def must(*args):
+        code, out, err = run(*args)
+        if code != 0:
+            print(f"FAIL probeloop {' '.join(args)}: exit {code}\n{out}\n{err}")
+            shutil.rmtree(workdir, ignore_errors=True)
+            raise SystemExit(1)
+        return out
+
+    return run, must

@@ -25,12 +25,11 @@ import json
 import math
 import os
 import shutil
-import subprocess
 import sys
 import tempfile
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from checks import Checks  # noqa: E402
+from checks import Checks, cli  # noqa: E402
 
 PL = os.environ["PROBELOOP"]
 SRC = os.environ["PROBELOOP_SOURCE_DIR"]
@@ -41,18 +40,7 @@ HEADER = "cycle,id,kind,x_mm,y_mm,z_mm,i,j,k,size_mm,form_um,n_points"
 NAMES = ["EX0C", "EY0C", "EZ0T", "ER0T", "EA0C", "EB0C", "EC0C"]
 
 
-def run(*args):
-    p = subprocess.run([PL, *args], capture_output=True, text=True)
-    return p.returncode, p.stdout, p.stderr
-
-
-def must(*args):
-    code, out, err = run(*args)
-    if code != 0:
-        print(f"FAIL probeloop {' '.join(args)}: exit {code}\n{err}")
-        shutil.rmtree(W, ignore_errors=True)
-        raise SystemExit(1)
-    return out
+run, must = cli(PL, W)
 
 
 def write(name, text, newline="\n"):

@@ -14,14 +14,13 @@ Needs $PROBELOOP and $PROBELOOP_SOURCE_DIR.
 import json
 import os
 import shutil
-import subprocess
 import sys
 import tempfile
 
 import yaml
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from checks import Checks  # noqa: E402
+from checks import Checks, cli  # noqa: E402
 
 PL = os.environ["PROBELOOP"]
 SRC = os.environ["PROBELOOP_SOURCE_DIR"]
@@ -32,18 +31,7 @@ W = tempfile.mkdtemp(prefix="probeloop-rotary-")
 check = Checks()
 
 
-def run(*args):
-    p = subprocess.run([PL, *args], capture_output=True, text=True)
-    return p.returncode, p.stdout, p.stderr
-
-
-def must(*args):
-    code, out, err = run(*args)
-    if code != 0:
-        print(f"FAIL probeloop {' '.join(args)}: exit {code}\n{out}\n{err}")
-        shutil.rmtree(W, ignore_errors=True)
-        raise SystemExit(1)
-    return out
+run, must = cli(PL, W)
 
 
 try:
