@@ -111,6 +111,7 @@ std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, 
     if (max_cycle > 0 && f.cycle > max_cycle)
       throw InputError(d.file, c.line, "measurement run " + std::to_string(f.cycle) + " (a cycle) is beyond the plan's " +
                                            std::to_string(max_cycle) + " cycles");
+    f.has_geometry = c.measured.given;
     f.location_mm = c.measured.location_mm;
     f.direction = c.measured.direction;
     f.size_mm = c.measured.diameter_mm;

@@ -37,6 +37,7 @@ struct FeatureActual {
   int n_points = 0;  // 0: not stated (QIF/DMIS features exported without their points)
   std::optional<Eigen::Vector3d> u_um;  // the CMM's stated standard uncertainty per coordinate
   std::optional<double> time_s;
+  bool has_geometry = true;  // false: a QIF/DMIS feature with points but no measured geometry
 };
 
 // max_cycle > 0 refuses a cycle beyond it (the plan's cycles).
