@@ -73,7 +73,7 @@ Subcommand addEvaluateCommand(CLI::App& app) {
   ev->add_option("--manifest", a->manifest, "plan manifest (plan.json)")->required()
       ->check(inputFile("the plan.json that `probeloop plan` wrote"));
   ev->add_option("--out", a->out, "output folder")->capture_default_str();
-  ev->add_option("--format", a->format, "auto, linuxcnc, fanuc, csv, features (sphere centres a CMM reports), cmm, qif, dmis or gauge")
+  ev->add_option("--format", a->format, "auto, linuxcnc, fanuc, csv, features (the fitted features a CMM reports, docs/formats.md), cmm, qif, dmis or gauge")
       ->check(CLI::IsMember({"auto", "linuxcnc", "fanuc", "csv", "features", "cmm", "qif", "dmis", "gauge"}))->capture_default_str();
   ev->add_flag("--free-radius", a->free_radius, "sphere centres from the free-radius fit (default: known radius)");
   ev->add_flag("--strict", a->strict, "QIF export: refuse what the lenient reader reads with a warning (docs/interop.md)");

@@ -5,6 +5,8 @@
 
 #include "core/csv.hpp"
 #include "core/error.hpp"
+#include "interop/dmis.hpp"
+#include "interop/qif.hpp"
 
 namespace probeloop::evaluate {
 
@@ -120,6 +122,29 @@ std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, 
     out.push_back(std::move(f));
   }
   if (out.empty()) throw InputError(d.file, 0, "no measured features in the file: nothing to evaluate");
+  return out;
+}
+
+std::optional<StatedFeatureFile> readStatedFeatures(const std::string& path, const std::string& text, bool strict) {
+  StatedFeatureFile out;
+  if (looksLikeFeatureActuals(text)) {
+    out.format = "features";
+    out.rows = parseFeatureActuals(text, path);
+    return out;
+  }
+  const bool qif = interop::looksLikeQif(text);
+  if (!qif && (!interop::looksLikeDmis(text) || interop::isDmisProgram(text))) return std::nullopt;
+  const interop::CmmReadOptions options{strict};
+  const auto d = qif ? interop::parseQifResults(text, path, options) : interop::parseDmisOutput(text, path, options);
+  bool points = false, geometry = false;
+  for (const auto& f : d.features) points |= !f.points.empty(), geometry |= f.measured.given;
+  if (points || !geometry) return std::nullopt;
+  if (d.runs > 1)
+    throw InputError(path, 0, std::to_string(d.runs) + " MeasurementResults (runs) in one file: the piece is measured once; write "
+                                                      "each run to its own file");
+  out.format = qif ? "qif" : "dmis";
+  out.rows = featureActualsFromCmm(d);
+  for (const auto& w : d.warnings) out.warnings.push_back(path + ":" + std::to_string(w.line) + ": " + w.what);
   return out;
 }
 

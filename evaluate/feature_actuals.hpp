@@ -54,6 +54,19 @@ std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, 
 // True when a CSV text's header holds the feature-actuals columns (for --format auto).
 bool looksLikeFeatureActuals(const std::string& text);
 
+// The features a CMM file states when it holds no points, for the pieces measured once
+// (thermal test piece, stepped workpiece): a feature-actuals CSV, or a QIF 3.0 Results / DMIS
+// output whose features carry measured geometry and none of them points. nullopt: the file holds
+// points (the point route reads it) or is neither. A QIF with several MeasurementResults is
+// refused (the piece is measured once). warnings: the lenient reader's, "file:line: what"; strict
+// refuses them instead.
+struct StatedFeatureFile {
+  std::string format;  // features | qif | dmis
+  std::vector<FeatureActual> rows;
+  std::vector<std::string> warnings;
+};
+std::optional<StatedFeatureFile> readStatedFeatures(const std::string& path, const std::string& text, bool strict);
+
 // A sphere centre of the plan, from the file: the row, the position it was matched to and how.
 struct StatedCentre {
   FeatureActual feature;

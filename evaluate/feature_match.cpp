@@ -42,7 +42,7 @@ Fit fitTo(const FeatureActual& r, const parts::NominalFeature& n) {
     f.distance_mm = std::fabs(d.dot(nn));
     const double out_u = std::max(0.0, std::fabs(d.dot(n.u)) - n.half_u_mm), out_v = std::max(0.0, std::fabs(d.dot(n.v())) - n.half_v_mm);
     f.away_mm = std::sqrt(f.distance_mm * f.distance_mm + out_u * out_u + out_v * out_v);
-    f.fits = angleDeg(r.direction, nn, false) <= kAngleDeg && f.distance_mm <= kNormalMm &&
+    f.fits = angleDeg(r.direction, nn, true) <= kAngleDeg && f.distance_mm <= kNormalMm &&
              std::fabs(d.dot(n.u)) <= n.half_u_mm + kExtentMarginMm && std::fabs(d.dot(n.v())) <= n.half_v_mm + kExtentMarginMm;
   } else if (n.kind == "cylinder") {
     const Eigen::Vector3d a = n.direction.normalized();

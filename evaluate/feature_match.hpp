@@ -4,7 +4,8 @@
 // then be in the part frame, as for points: evaluate/ttp_ingest.hpp assignByNominalGeometry).
 //
 // Geometry rules (docs/formats.md#feature-actuals-csv), for a row of a foreign id:
-// - plane row -> plane feature: normals within 1 deg, the row's location within 0.5 mm of the
+// - plane row -> plane feature: normals within 1 deg (either sense: a fitted plane's normal
+//   has no material side unless the software adds one), the row's location within 0.5 mm of the
 //   nominal plane and inside its extent + 1 mm (CMM software reports a plane at the centroid of
 //   its points, which lies on the face);
 // - circle or cylinder row -> cylinder feature: axes within 1 deg (either sense), the location

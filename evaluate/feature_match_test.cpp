@@ -70,7 +70,8 @@ std::string refusal(const std::vector<FeatureActual>& rows) {
 TEST(MatchFeatureActuals, ByIdAndByNominalGeometryInFileOrder) {
   const auto m = plan();
   // Z2's strip is y in [-6, 6] (+1 mm margin); the row lies 5 mm off its centre line, 20 um deep.
-  const auto r = matchFeatureActuals({row(2, "PLN_7", "plane", {30, 5, -12.12}, Eigen::Vector3d(1e-5, 0, 1).normalized()),
+  // PLN_7 states its normal into the material: a plane matches in either sense.
+  const auto r = matchFeatureActuals({row(2, "PLN_7", "plane", {30, 5, -12.12}, Eigen::Vector3d(1e-5, 0, -1).normalized()),
                                       row(3, "X1_1", "plane", {-100.002, 3, -20}, {-1, 0, 0}),
                                       row(4, "CIR_1", "circle", {0.001, -0.002, -16}, {0, 0, -1}, 201.0),
                                       row(5, "PT_1", "point", {0, 0, 0}, {0, 0, 0})},

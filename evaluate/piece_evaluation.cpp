@@ -105,7 +105,17 @@ EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateReq
   opt.gauge_resolution_um = r.gauge_resolution_um;
   TtpEvaluation e;
   std::optional<TtpPoints> points;
-  if (fmt == "cmm" || fmt == "qif" || fmt == "dmis") {  // a CSV export, QIF 3.0 Results or DMIS output
+  std::vector<std::string> warnings;
+  // Only the fitted features, no points (issue 34): the plan's points placed on them.
+  std::optional<StatedFeatureFile> stated;
+  if (fmt == "features")
+    stated = StatedFeatureFile{"features", parseFeatureActuals(text, r.input_file), {}};
+  else if (fmt == "qif" || fmt == "dmis")
+    stated = readStatedFeatures(r.input_file, text, r.strict);
+  if (stated) {
+    e = evaluateThermalTestPieceFromFeatures(m, stated->rows, r.input_file, stated->format, opt);
+    warnings = stated->warnings;
+  } else if (fmt == "cmm" || fmt == "qif" || fmt == "dmis") {  // a CSV export, QIF 3.0 Results or DMIS output
     points = readTtpCmmExport(r.input_file, text, m, r.strict);
     e = evaluateThermalTestPiece(m, *points, opt);
   } else if (fmt == "linuxcnc" || fmt == "fanuc" || fmt == "log" || fmt == "csv") {
@@ -115,7 +125,7 @@ EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateReq
     if (!(r.gauge_resolution_um > 0)) throw InputError("", 0, "the gauge resolution must be positive");
     e = evaluateThermalTestPieceGauge(m, readTtpGauge(r.input_file, text, m), opt);
   } else {
-    throw InputError("", 0, "--format '" + r.format + "': expected auto, cmm, qif, dmis, linuxcnc, fanuc, csv or gauge");
+    throw InputError("", 0, "--format '" + r.format + "': expected auto, cmm, qif, dmis, features, linuxcnc, fanuc, csv or gauge");
   }
   if (!r.compare_with.empty()) e.comparison = compareSpans(e, r.compare_with);
   EvaluationFiles f;
@@ -125,7 +135,8 @@ EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateReq
   f.report_md = ttpReport(e);
   f.stdout_text = ttpStdout(e, pathIn(r.out_dir, EvaluationFiles::kErrorsCsv), pathIn(r.out_dir, EvaluationFiles::kEvaluationJson),
                             pathIn(r.out_dir, EvaluationFiles::kReportMd));
-  if (points) f.stdout_text += warningLines(points->warnings);
+  if (points) warnings = points->warnings;
+  f.stdout_text += warningLines(warnings);
   f.thermal_test_piece = std::move(e);
   return f;
 }

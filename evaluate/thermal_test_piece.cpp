@@ -5,6 +5,7 @@
 // ttp_spans.cpp (ttp_detail.hpp lists them).
 #include "evaluate/thermal_test_piece.hpp"
 
+#include <cmath>
 #include <map>
 #include <string>
 #include <vector>
@@ -44,7 +45,8 @@ std::string lineList(const std::vector<int>& lines) {
                        (lines.empty() ? "" : " (lines " + lineList(lines) + ")") + ": " + what);
 }
 
-TtpEvaluation evaluateImpl(const parts::PlanManifest& m, const TtpPoints& in, const TtpOptions& opt, bool predicted) {
+TtpEvaluation evaluateImpl(const parts::PlanManifest& m, const TtpPoints& in, const TtpOptions& opt, bool predicted,
+                           const StatedSigmas* stated) {
   if (m.kind != "thermal_test_piece")
     throw InputError(m.file, 0, "manifest kind '" + m.kind + "': this evaluation is for the thermal test piece");
   TtpEvaluation e;
@@ -80,6 +82,33 @@ TtpEvaluation evaluateImpl(const parts::PlanManifest& m, const TtpPoints& in, co
   // Scatter per point.
   const double sigma_spec_om = m.probe_repeatability_2sigma_um / 2 * 1e-3;
   setPointScatter(pts, m, in.route, sigma_spec_om);
+  TtpScatter stated_scatter;
+  if (stated) {
+    // The features route: each placed point's scatter as the file states it (docs/formats.md).
+    double sb2 = 0;
+    int nb = 0;
+    for (const auto& p : pts) {
+      const auto* f = m.feature(p.feature);
+      if (f->nominal.role == "z_path" || f->nominal.role == "facet") sb2 += p.sigma_b_mm * p.sigma_b_mm, ++nb;
+    }
+    stated_scatter = statedScatter(m, *stated, nb ? std::sqrt(sb2 / nb) : sigma_spec_om);
+    e.stated.emplace();
+    std::map<std::string, std::pair<double, int>> sum;
+    std::map<std::string, const char*> from;
+    for (auto& p : pts) {
+      const auto [sigma, why] = statedPointSigma(p.sigma_b_mm, stated->at(p.feature), stated_scatter);
+      p.sigma_b_mm = sigma;
+      sum[p.feature].first += sigma * sigma, ++sum[p.feature].second;
+      if (!from.count(p.feature) || std::string(why) == "stated u") from[p.feature] = why;
+    }
+    for (const auto& [id, a] : sum) {
+      TtpStatedFeature f;
+      f.id = id;
+      f.sigma_um = std::sqrt(a.first / a.second) * 1e3;
+      f.sigma_from = from[id];
+      e.stated->features.push_back(f);
+    }
+  }
 
   // Alignment report.
   e.alignment = alignmentReport(datums.sets, datums.fits, opt.form_mz);
@@ -89,10 +118,13 @@ TtpEvaluation evaluateImpl(const parts::PlanManifest& m, const TtpPoints& in, co
   const auto planes = fitFeatures(m, file, pts, by, times, opt.form_mz, e.features);
 
   // Type A: pooled residual of the measurement-feature fits.
-  e.scatter = pooledScatter(planes, pts, sigma_spec_om, predicted);
+  // (The features route: the stated forms pooled instead; the budgets take each point's sigma.)
+  e.scatter = stated ? stated_scatter : pooledScatter(planes, pts, sigma_spec_om, predicted);
 
   // Quantities per feature.
-  FeatureQuantities fq = featureQuantities(m, planes, pts, e.scatter, e.features);
+  TtpScatter per_point = e.scatter;
+  if (stated) per_point.type_a_used = false;  // the features route: already in each point's sigma
+  FeatureQuantities fq = featureQuantities(m, planes, pts, per_point, e.features);
 
   // Frame sensitivities to every datum point (central differences of the construction).
   BudgetContext ctx;
@@ -101,6 +133,7 @@ TtpEvaluation evaluateImpl(const parts::PlanManifest& m, const TtpPoints& in, co
   ctx.pts = &pts;
   ctx.scatter = e.scatter;
   ctx.predicted = predicted;
+  ctx.stated = stated != nullptr;
   ctx.k = opt.coverage_k;
   if (opt.budgets) ctx.datum_sens = datumSensitivities(datums.sets, datums.fits, by);
 

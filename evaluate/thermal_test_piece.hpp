@@ -36,6 +36,7 @@
 #include <string>
 #include <vector>
 
+#include "evaluate/feature_actuals.hpp"
 #include "evaluate/ttp_ingest.hpp"
 #include "parts/feature.hpp"
 #include "parts/plan_manifest.hpp"
@@ -137,6 +138,20 @@ struct TtpComparison {
   std::vector<std::string> left_out;     // spans not compared and why (incomplete in either run)
 };
 
+// The features route (issue 34): a feature the file stated, and how its scatter was taken.
+struct TtpStatedFeature {
+  std::string id, file_id, matched_by;  // manifest id; the file's id; "id" | "nominal geometry"
+  int line = 0, n_stated = 0, n_planned = 0;  // n_stated 0: not stated
+  std::optional<double> form_um;              // as stated
+  double sigma_um = 0;                        // per placed point in the budget (RMS over them)
+  std::string sigma_from;                     // specification | stated form | stated u
+};
+struct TtpStatedFeatures {
+  std::vector<TtpStatedFeature> features;  // datums first, then the manifest's order
+  std::vector<std::string> unmatched;      // rows not used: "file:line: kind 'id' (nearest X, d mm)"
+  int other_kinds = 0;                     // point or line rows, not used
+};
+
 struct TtpEvaluation {
   std::string manifest_file, input_file, format, assigned_by;
   TtpRoute route = TtpRoute::Cmm;
@@ -151,9 +166,19 @@ struct TtpEvaluation {
   std::vector<parts::EvaluationRule> formulas;
   std::vector<std::string> notes;          // route-specific statements (e.g. what the gauge cannot give)
   double gauge_resolution_um = 0;          // gauge route
+  std::optional<TtpStatedFeatures> stated;  // the features route
 };
 
 TtpEvaluation evaluateThermalTestPiece(const parts::PlanManifest& m, const TtpPoints& points, const TtpOptions& options = {});
+// From the features a CMM states (feature CSV, QIF MeasuredFeatures or DMIS FA actuals without
+// points; evaluate/feature_match.hpp, evaluate/feature_points.hpp): the plan's points placed on
+// each stated feature, then the CMM route's steps, so every value equals the point route's from
+// the same least-squares features; the budget's point scatter per feature is the larger of the
+// CMM's MPE(L)/2 and the stated form over d2(n) (times sqrt(n_planned / n_stated)), or a stated u
+// of the location where larger; no type A (no residuals); e.notes says what is lost.
+TtpEvaluation evaluateThermalTestPieceFromFeatures(const parts::PlanManifest& m, const std::vector<FeatureActual>& rows,
+                                                   const std::string& file, const std::string& format,
+                                                   const TtpOptions& options = {});
 TtpEvaluation evaluateThermalTestPieceGauge(const parts::PlanManifest& m, const TtpGaugeReadings& readings,
                                             const TtpOptions& options = {});
 

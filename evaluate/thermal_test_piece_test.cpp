@@ -24,29 +24,6 @@ namespace {
 using namespace ttptest;
 using Eigen::Vector3d;
 
-// Cycle c's value of quantity q; fails the test when absent.
-double value(const TtpEvaluation& e, int c, const std::string& q) {
-  for (const auto& x : e.cycles)
-    if (x.cycle == c) {
-      const auto* b = x.value(q);
-      if (!b) ADD_FAILURE() << "cycle " << c << " has no " << q;
-      return b ? b->value : NAN;
-    }
-  ADD_FAILURE() << "no cycle " << c;
-  return NAN;
-}
-const uncertainty::Budget& budget(const TtpEvaluation& e, int c, const std::string& q) {
-  for (const auto& x : e.cycles)
-    if (x.cycle == c && x.value(q)) return *x.value(q);
-  throw std::logic_error("no budget " + q);
-}
-double contribution(const uncertainty::Budget& b, const std::string& starts_with) {
-  for (const auto& c : b.contributions)
-    if (c.input.rfind(starts_with, 0) == 0) return c.u;
-  ADD_FAILURE() << b.quantity << " has no contribution '" << starts_with << "'";
-  return NAN;
-}
-
 std::string refusal(const std::function<void()>& f) {
   try {
     f();
@@ -60,44 +37,6 @@ TtpEvaluation evaluateCmm(const Fixture& f, const std::string& csv, const TtpOpt
   return evaluateThermalTestPiece(f.m, readTtpCmmExport("cmm.csv", csv, f.m), o);
 }
 
-// The chosen surfaces (hand-derived errors below):
-//  cycle 2: all four facets cut g = 4 um smaller (a warm piece, smaller at 20 C);
-//  cycle 3: the table shifted by e = 5 um in +X: X1 at a - e, X2 at a + e;
-//  cycle 4: shifted by f = -3 um in Y: Y1 at a - f, Y2 at a + f;
-//  cycle 5: Z path cut 7 um deeper; cycle 6: Z path tilted by 20 urad about +Y.
-Truth chosen(const Fixture& f) {
-  Truth t;
-  for (const char* s : {"X1", "X2", "Y1", "Y2"}) t.offset_mm[facetId(f, s, 2)] = -0.004;
-  t.offset_mm[facetId(f, "X1", 3)] = -0.005;
-  t.offset_mm[facetId(f, "X2", 3)] = +0.005;
-  t.offset_mm[facetId(f, "Y1", 4)] = +0.003;
-  t.offset_mm[facetId(f, "Y2", 4)] = -0.003;
-  t.offset_mm[zId(f, 5)] = 0.007;
-  t.beta_rad[zId(f, 6)] = 20e-6;
-  return t;
-}
-
-void expectChosenErrors(const TtpEvaluation& e, double tol = 1e-6) {
-  // Eq. 7.1 (corrected): E_X = [(d_X2,i - d_X2,0) - (d_X1,i - d_X1,0)] / 2.
-  EXPECT_NEAR(value(e, 3, "EX_um"), ((+5.0) - (-5.0)) / 2, tol);
-  EXPECT_NEAR(value(e, 2, "EX_um"), ((-4.0) - (-4.0)) / 2, tol);
-  EXPECT_NEAR(value(e, 4, "EY_um"), ((-3.0) - (+3.0)) / 2, tol);
-  // Eq. 7.3: [dl_X + dl_Y] / 2 with l = d1 + d2: growth -4 um on all four -> (-8 - 8) / 2.
-  EXPECT_NEAR(value(e, 2, "ETTP_um"), (-8.0 + -8.0) / 2, tol);
-  EXPECT_NEAR(value(e, 3, "ETTP_um"), 0.0, tol);
-  // Eq. 7.10: dT = -E_TTP,7.9 / (alpha R) = 4 um / (22e-6 * 97.5 mm).
-  EXPECT_NEAR(value(e, 2, "dT_K"), 4.0 / (22e-6 * 97.5e3), 1e-6);
-  EXPECT_NEAR(value(e, 5, "EZ_um"), 7.0, tol);
-  EXPECT_NEAR(value(e, 5, "EB_urad"), 0.0, 1e-4);
-  EXPECT_NEAR(value(e, 6, "EB_urad"), 20.0, 1e-4);
-  EXPECT_NEAR(value(e, 6, "EZ_um"), 0.0, tol);  // the tilt leaves the depth at x = 0
-  for (int c : {1, 7, 8})
-    for (const char* q : {"EX_um", "EY_um", "EZ_um", "EB_urad", "ETTP_um", "dT_K"}) EXPECT_NEAR(value(e, c, q), 0.0, 1e-4) << c << q;
-  for (const char* q : {"EX_um", "EY_um", "EZ_um", "EB_urad", "ETTP_um", "dT_K"}) {
-    EXPECT_EQ(value(e, 0, q), 0.0);
-    EXPECT_EQ(budget(e, 0, q).U, 0.0);
-  }
-}
 
 TEST(TtpEvaluation, HandDerivedErrorsFromDisplacedSurfaces) {
   const auto f = makeFixture();
@@ -769,7 +708,7 @@ TEST(TtpOutputs, FormatsAreDetectedFromTheContent) {
   r.input_file = tempFile("gauge.csv", "facet,g_um\nX1_1,1\nX2_1,3\n");
   EXPECT_EQ(evaluateTestPiece(f.m, r).thermal_test_piece->route, TtpRoute::Gauge);
   r.format = "sphere";
-  EXPECT_NE(refusal([&] { evaluateTestPiece(f.m, r); }).find("expected auto, cmm, qif, dmis, linuxcnc, fanuc, csv or gauge"), std::string::npos);
+  EXPECT_NE(refusal([&] { evaluateTestPiece(f.m, r); }).find("expected auto, cmm, qif, dmis, features, linuxcnc, fanuc, csv or gauge"), std::string::npos);
 }
 
 TEST(TtpPrediction, BothRoutesFromThePlannedPointsAlone) {

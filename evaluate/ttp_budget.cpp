@@ -79,9 +79,23 @@ uncertainty::Budget valueBudget(const ValueSpec& v, const BudgetContext& ctx) {
   const auto& sc = ctx.scatter;
   const bool cmm = ctx.route == TtpRoute::Cmm;
   const std::string both = ", this and the reference cycle";
-  const std::string spec_name = cmm ? "CMM probing error (specification)" : "probe repeatability (specification)";
+  const std::string spec_name = ctx.stated ? "CMM point scatter from the stated features"
+                                : cmm       ? "CMM probing error (specification)"
+                                            : "probe repeatability (specification)";
   const std::string spec_basis =
-      cmm ? "MPE = " + num(m.ttp.cmm.mpe_constant_um) + " um" +
+      ctx.stated
+          ? std::string(sc.type_a_used ? "the stated forms of the Z paths and facets pooled (form / (d2(n) sqrt((n - 3)/n)) per "
+                                         "feature): s = " + num(sc.type_a_sigma_mm * 1e3) + " um, nu = " + num(sc.type_a_dof) +
+                                         ", larger than the specification MPE(L)/2"
+                                       : "MPE(L)/2 per point (thermal_test_piece.cmm, MPE = " + num(m.ttp.cmm.mpe_constant_um) + " um" +
+                                         (m.ttp.cmm.mpe_length_mm > 0 ? " + L/" + num(m.ttp.cmm.mpe_length_mm) : std::string()) + ")" +
+                                         (sc.type_a_dof > 0 ? "; the stated forms pooled give s = " + num(sc.type_a_sigma_mm * 1e3) +
+                                                                  " um (nu = " + num(sc.type_a_dof) + "), not larger"
+                                                            : "; no form stated")) +
+                "; times sqrt(n_planned / n_stated) per feature, or the sigma a stated u of the location implies where larger "
+                "(evaluation.json stated_features); the plan's points placed on the stated features, through each plane fit's "
+                "(J^T J)^-1"
+      : cmm ? "MPE = " + num(m.ttp.cmm.mpe_constant_um) + " um" +
                 (m.ttp.cmm.mpe_length_mm > 0 ? " + L/" + num(m.ttp.cmm.mpe_length_mm) : std::string()) +
                 " (thermal_test_piece.cmm; seed 004 L2145), sigma = MPE(L)/2 per point, L = distance from the origin; "
                 "through each plane fit's (J^T J)^-1"
@@ -89,7 +103,10 @@ uncertainty::Budget valueBudget(const ValueSpec& v, const BudgetContext& ctx) {
                 " um: sigma = " + num(m.probe_repeatability_2sigma_um / 2) + " um per point; through each plane fit's (J^T J)^-1";
   const std::string pooled = "pooled residual of the Z-path and facet plane fits: s = " + num(sc.type_a_sigma_mm * 1e3) +
                              " um, nu = " + num(sc.type_a_dof);
-  if (sc.type_a_used) {
+  if (ctx.stated) {
+    add(spec_name + both, sc.type_a_used ? 'A' : 'B', "normal", spec_basis, std::sqrt(sb2), sc.type_a_used ? sc.type_a_dof : kInf);
+    add("point scatter (type A)" + both, 'A', "normal", "needs the points: the file states the features only (their forms enter the line above)", 0);
+  } else if (sc.type_a_used) {
     add("point scatter (type A)" + both, 'A', "normal", pooled, sc.type_a_sigma_mm * std::sqrt(sum_g2), sc.type_a_dof);
     add(spec_name + both, 'B', "normal", spec_basis + "; not added: the type A estimate of the same scatter is larger", 0);
   } else {
@@ -150,7 +167,7 @@ uncertainty::Budget valueBudget(const ValueSpec& v, const BudgetContext& ctx) {
   double a2 = 0;
   for (const auto& [i, dxi] : ctx.datum_sens) {
     const auto& p = pts[static_cast<std::size_t>(i)];
-    const double sigma = sc.type_a_used ? sc.type_a_sigma_mm : p.sigma_b_mm;
+    const double sigma = sc.type_a_used && !ctx.stated ? sc.type_a_sigma_mm : p.sigma_b_mm;
     const double gi = G.dot(dxi);
     a2 += (sigma * sigma + p.sigma_res_mm * p.sigma_res_mm) * gi * gi;
   }

@@ -153,6 +153,7 @@ struct BudgetContext {
   double k = 2.0;
   // Datum points: index and d(dO, omega)/d(normal displacement).
   std::vector<std::pair<int, Vector6d>> datum_sens;
+  bool stated = false;  // the features route: the points placed on the file's features
 };
 
 // Scatter per point: sigma_b_mm (CMM: MPE(L)/2; on-machine: sigma_spec_om) and, on the machine,
@@ -213,8 +214,32 @@ std::vector<TtpCycleResult> cycleValues(const parts::PlanManifest& m, const std:
 
 // --- the evaluation (thermal_test_piece.cpp) ---------------------------------------------------
 
+// The features route (ttp_features.cpp): per manifest feature, what the file states about the
+// scatter of its points (evaluate/feature_points.hpp). NaN: not stated.
+struct StatedSigma {
+  double scale = 1.0;    // sqrt(n_planned / n_stated): a placed point stands for several measured ones
+  double form_mm = NAN;  // the form-based sigma of one measured point (sigmaFromForm)
+  double dof = 0;        // its degrees of freedom, n - 3 (0: no form)
+  double u_mm = NAN;     // from a stated u of the location: the sigma per placed point that gives it
+};
+using StatedSigmas = std::map<std::string, StatedSigma>;
+// The stated forms of the Z paths and facets pooled as the point route pools their residuals:
+// s^2 = sum(nu_f s_f^2) / sum(nu_f), in TtpScatter's type A fields; used when larger than the
+// specification (type_a_used).
+TtpScatter statedScatter(const parts::PlanManifest& m, const StatedSigmas& s, double type_b_sigma_mm);
+// sigma per placed point: the pooled form-based s (when used) or the point's specification,
+// times the feature's scale, or the sigma its stated u implies where larger; and which it was
+// ("specification", "stated forms", "stated u").
+std::pair<double, const char*> statedPointSigma(double spec_mm, const StatedSigma& s, const TtpScatter& pooled);
+
 // The CMM and on-machine routes; predicted: from the planned points (type B scatter only, the
-// terms that scale with measured values listed with 0).
-TtpEvaluation evaluateImpl(const parts::PlanManifest& m, const TtpPoints& in, const TtpOptions& opt, bool predicted);
+// terms that scale with measured values listed with 0); stated: the features route (the points
+// placed on the file's features; their scatter from statedScatter and statedPointSigma, e.stated's
+// sigma per feature filled).
+TtpEvaluation evaluateImpl(const parts::PlanManifest& m, const TtpPoints& in, const TtpOptions& opt, bool predicted,
+                           const StatedSigmas* stated = nullptr);
+// The planned surface points of every probed feature in the part frame (the manifest's contact
+// points: the tip centre moved by the tip radius along the approach, C undone).
+std::map<std::string, std::vector<Vector3d>> plannedSurfacePoints(const parts::PlanManifest& m);
 
 }  // namespace probeloop::evaluate::ttp

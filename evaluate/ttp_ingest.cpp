@@ -11,6 +11,7 @@
 #include "core/csv.hpp"
 #include "core/input_file.hpp"
 #include "core/error.hpp"
+#include "evaluate/feature_actuals.hpp"
 #include "interop/dmis.hpp"
 #include "interop/qif.hpp"
 #include "core/units.hpp"
@@ -138,6 +139,7 @@ std::string detectTtpFormat(const std::string& path, const std::string& text) {
     return "log";
   }
   const auto h = csvHeaderFields(text);
+  if (looksLikeFeatureActuals(text)) return "features";
   if (has(h, "g_um")) return "gauge";
   if (has(h, "c_deg") || has(h, "time_s")) return "csv";
   return "cmm";

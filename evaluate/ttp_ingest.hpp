@@ -59,8 +59,9 @@ struct TtpGaugeReadings {
   std::vector<TtpGaugeReading> readings;
 };
 
-// Format names: cmm | linuxcnc | fanuc | log | csv | gauge. Detection: a CSV whose header has
-// g_um is a gauge file, one with c_deg or time_s the on-machine points CSV, any other CSV a
+// Format names: cmm | linuxcnc | fanuc | log | csv | gauge | features. Detection: a CSV with the
+// feature-actuals columns (evaluate/feature_actuals.hpp) is features, one whose header has
+// g_um a gauge file, one with c_deg or time_s the on-machine points CSV, any other CSV a
 // CMM export; a file that is not CSV a probe log ("log": LinuxCNC and Fanuc lines parse alike).
 std::string detectTtpFormat(const std::string& path, const std::string& text);
 

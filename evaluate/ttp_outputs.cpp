@@ -21,7 +21,7 @@ ordered_json opt(const std::optional<double>& v) { return v ? ordered_json(*v) :
 
 std::string routeWords(const TtpEvaluation& e) {
   switch (e.route) {
-    case TtpRoute::Cmm: return "CMM export";
+    case TtpRoute::Cmm: return e.stated ? "the features a CMM states (" + e.format + ")" : "CMM export";
     case TtpRoute::OnMachine: return "on-machine probing (" + e.format + ")";
     case TtpRoute::Gauge: return "dial gauge on the machine (seed 004 Eqs. 7.7-7.9)";
   }
@@ -127,6 +127,23 @@ std::string ttpEvaluationJson(const TtpEvaluation& e) {
                         {"type_a_sigma_um", e.scatter.type_a_sigma_mm * 1e3},
                         {"type_a_dof", e.scatter.type_a_dof},
                         {"used", e.scatter.type_a_used ? "type A" : "type B"}};
+  if (e.stated) {
+    ordered_json st = ordered_json::array();
+    for (const auto& f : e.stated->features)
+      st.push_back({{"id", f.id},
+                    {"file_id", f.file_id},
+                    {"line", f.line},
+                    {"matched_by", f.matched_by},
+                    {"n_points_stated", f.n_stated},
+                    {"n_points_planned", f.n_planned},
+                    {"form_um", opt(f.form_um)},
+                    {"point_sigma_um", f.sigma_um},
+                    {"point_sigma_from", f.sigma_from}});
+    j["stated_features"] = {{"features", st},
+                            {"unmatched", e.stated->unmatched},
+                            {"rows_of_other_kinds_not_used", e.stated->other_kinds},
+                            {"notes", e.notes}};
+  }
   j["features"] = ordered_json::array();
   for (const auto& f : e.features)
     j["features"].push_back({{"id", f.id},
@@ -217,15 +234,29 @@ std::string ttpReport(const TtpEvaluation& e) {
     for (const auto& d : a.datums) o << "| " << d.id << " | " << d.points << " | " << formatNumber(d.form_um, 3) << " |\n";
     o << "\n";
   }
+  if (e.stated) {
+    o << "## Stated features\n\nThe file's features as matched to the plan's, their stated point count and form, and the scatter "
+         "per placed point the budget used (docs/thermal-test-piece-evaluation.md §8).\n\n"
+         "| feature | file's id | line | matched by | n stated | n placed | form (um) | sigma per placed point (um) | from |\n"
+         "|---|---|---|---|---|---|---|---|---|\n";
+    for (const auto& f : e.stated->features)
+      o << "| " << f.id << " | " << f.file_id << " | " << f.line << " | " << f.matched_by << " | "
+        << (f.n_stated ? std::to_string(f.n_stated) : "not stated") << " | " << f.n_planned << " | "
+        << (f.form_um ? formatNumber(*f.form_um, 3) : "not stated") << " | " << formatNumber(f.sigma_um, 3) << " | " << f.sigma_from << " |\n";
+    for (const auto& u : e.stated->unmatched) o << "\nNot used (fits no feature of the plan): " << u << "\n";
+    o << "\n";
+  }
   if (e.route != TtpRoute::Gauge) {
-    o << "Point scatter: specification sigma = " << formatNumber(e.scatter.type_b_sigma_mm * 1e3, 4)
+    if (!e.stated)
+      o << "Point scatter: specification sigma = " << formatNumber(e.scatter.type_b_sigma_mm * 1e3, 4)
       << " um (RMS over the measurement points), pooled plane-fit residual s = " << formatNumber(e.scatter.type_a_sigma_mm * 1e3, 4)
       << " um (nu = " << formatNumber(e.scatter.type_a_dof) << "); the budgets use the " << (e.scatter.type_a_used ? "type A s" : "specification")
       << ".\n\n";
-    o << "## Features\n\n| feature | cycle | points | rms (um) | form MZ (um) | d (mm) | depth (mm) | beta (urad) | u point scatter (um) |\n"
+    o << "## Features\n\n| feature | cycle | points | rms (um) | " << (e.stated ? "form as stated (um)" : "form MZ (um)") << " | d (mm) | depth (mm) | beta (urad) | u point scatter (um) |\n"
          "|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& f : e.features)
-      o << "| " << f.id << " | " << f.cycle << " | " << f.points << " | " << formatNumber(f.rms_um, 3) << " | " << formatNumber(f.form_mz_um, 3)
+      o << "| " << f.id << " | " << f.cycle << " | " << f.points << " | " << (e.stated ? "-" : formatNumber(f.rms_um, 3)) << " | "
+        << formatNumber(f.form_mz_um, 3)
         << " | " << (f.d_mm ? formatNumber(*f.d_mm, 5) : "") << " | " << (f.depth_mm ? formatNumber(*f.depth_mm, 5) : "") << " | "
         << (f.beta_urad ? formatNumber(*f.beta_urad, 2) : "") << " | " << formatNumber(f.u_d_um, 3) << " |\n";
     o << "\n";
@@ -343,9 +374,13 @@ std::string ttpStdout(const TtpEvaluation& e, const std::string& errors_file, co
                       const std::string& report_file) {
   std::ostringstream o;
   const auto cols = columns(e);
-  o << "Thermal test piece (seed 004 Ch. 7), " << routeWords(e) << ": " << e.input_file << ", " << e.points
-    << (e.route == TtpRoute::Gauge ? " readings" : " points") << (e.route == TtpRoute::Gauge ? "" : " assigned by " + e.assigned_by)
-    << "\nErrors relative to the reference cut (cycle 0); U for k = " << formatNumber(e.coverage_k) << "\n";
+  o << "Thermal test piece (seed 004 Ch. 7), " << routeWords(e) << ": " << e.input_file << ", ";
+  if (e.stated)
+    o << e.stated->features.size() << " features matched by " << e.assigned_by << " (no points: the plan's " << e.points
+      << " points placed on them)";
+  else
+    o << e.points << (e.route == TtpRoute::Gauge ? " readings" : " points") << (e.route == TtpRoute::Gauge ? "" : " assigned by " + e.assigned_by);
+  o << "\nErrors relative to the reference cut (cycle 0); U for k = " << formatNumber(e.coverage_k) << "\n";
   o << pad("cycle", 6) << " " << pad("phase", 10, true) << pad("time_h", 7);
   for (const auto& q : cols) o << " " << pad(q, 17);
   o << " " << pad("dT_K", 15) << "\n";
