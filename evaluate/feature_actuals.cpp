@@ -19,6 +19,22 @@ bool blank(const CsvRow& r, int c) { return c < 0 || c >= static_cast<int>(r.fie
 
 std::string line(const FeatureActual& f) { return std::to_string(f.line); }
 
+// A measurement of a machined part: beyond 1 km (mm fields) or 1 m (um fields) it is a broken
+// file, and squared in a budget it would overflow to inf.
+void checkPlausible(const FeatureActual& f) {
+  constexpr double kMaxMm = 1e6, kMaxUm = 1e6;
+  auto fail = [&](const std::string& field, double v, const char* unit, double max) {
+    throw InputError(f.file, f.line, field + ": " + formatNumber(v) + " " + unit + " is not a plausible measurement (at most " +
+                                         formatNumber(max) + " " + unit + ")");
+  };
+  const char* xyz[3] = {"x_mm", "y_mm", "z_mm"};
+  for (int a = 0; a < 3; ++a)
+    if (std::fabs(f.location_mm(a)) > kMaxMm) fail(xyz[a], f.location_mm(a), "mm", kMaxMm);
+  if (std::isfinite(f.size_mm) && f.size_mm > kMaxMm) fail("size_mm", f.size_mm, "mm", kMaxMm);
+  if (std::isfinite(f.form_um) && f.form_um > kMaxUm) fail("form_um", f.form_um, "um", kMaxUm);
+  if (f.u_um && f.u_um->maxCoeff() > kMaxUm) fail("u_x_um,u_y_um,u_z_um", f.u_um->maxCoeff(), "um", kMaxUm);
+}
+
 }  // namespace
 
 bool looksLikeFeatureActuals(const std::string& text) {
@@ -92,6 +108,7 @@ std::vector<FeatureActual> parseFeatureActuals(const std::string& text, const st
       f.u_um = u;
     }
     if (!blank(row, c_time)) f.time_s = t.number(row, c_time);
+    checkPlausible(f);
     out.push_back(std::move(f));
   }
   if (out.empty()) throw InputError(file, t.header_line, "no features in the file: nothing to evaluate");
@@ -119,6 +136,7 @@ std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, 
     f.size_mm = c.measured.diameter_mm;
     f.form_um = c.measured.form_mm * 1e3;
     f.n_points = static_cast<int>(std::min<std::size_t>(c.points.size(), 1000000000));
+    if (f.has_geometry) checkPlausible(f);
     out.push_back(std::move(f));
   }
   if (out.empty()) throw InputError(d.file, 0, "no measured features in the file: nothing to evaluate");

@@ -12,7 +12,9 @@
 //
 // Contract: InputError with file:line:field for a missing column, an unknown kind, a field that
 // is not a number where one is needed, a count that is not a positive integer, a negative
-// size/form/u, a direction of zero length where one is needed. Nothing is guessed silently.
+// size/form/u, a direction of zero length where one is needed, a coordinate or size beyond 1 km
+// or a form or u beyond 1 m (not a measurement: it would overflow a budget). Nothing is guessed
+// silently.
 #pragma once
 #include <Eigen/Dense>
 #include <map>

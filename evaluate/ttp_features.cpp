@@ -1,5 +1,5 @@
 // The thermal test piece from the features a CMM states (contract in thermal_test_piece.hpp,
-// docs/thermal-test-piece-evaluation.md §8): the rows matched to the plan's features, the plan's
+// docs/thermal-test-piece-evaluation.md §10): the rows matched to the plan's features, the plan's
 // points placed on them (evaluate/feature_points.hpp), then the CMM route's steps with the
 // scatter the file states.
 #include <algorithm>

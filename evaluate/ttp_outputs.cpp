@@ -236,7 +236,7 @@ std::string ttpReport(const TtpEvaluation& e) {
   }
   if (e.stated) {
     o << "## Stated features\n\nThe file's features as matched to the plan's, their stated point count and form, and the scatter "
-         "per placed point the budget used (docs/thermal-test-piece-evaluation.md §8).\n\n"
+         "per placed point the budget used (docs/thermal-test-piece-evaluation.md §10).\n\n"
          "| feature | file's id | line | matched by | n stated | n placed | form (um) | sigma per placed point (um) | from |\n"
          "|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& f : e.stated->features)

@@ -170,6 +170,25 @@ put("gcode_fanuc", "hostile_goto.nc", "N1 GOTO1\nM30\n")
 put("gcode_fanuc", "hostile_params.nc", "#1=1e308\n#2=#1*#1\nIF[#2EQ#2]GOTO5\nN5 #3000=1(ALARM)\n#500=[1/0]\nG31 Z-1e308 F0\nPOPEN\nDPRNT[X*#5061[53]]\nPCLOS\nM30\n")
 put("gcode_fanuc", "hostile_nesting.nc", "".join(f"WHILE[1LT0]DO{i % 3 + 1}\n" for i in range(200)) + "M30\n")
 
+# --- feature actuals (issue 34) ----------------------------------------------------------------
+# The thermal test piece's features at their nominal geometry (every one of the fuzz plan, the
+# datum band as a circle), under foreign ids: the whole features route; and hostile rows.
+import json  # noqa: E402
+FA = "cycle,id,kind,x_mm,y_mm,z_mm,i,j,k,size_mm,form_um,n_points\n"
+plan = json.load(open(os.path.join(ROOT, "fuzz", "fixtures", "ttp_plan.json")))
+rows = []
+for k, f in enumerate(plan["features"]):
+    (x, y, z), (i, j, kk) = f["point_mm"], f["direction"]
+    if f["kind"] == "cylinder":
+        rows.append(f"1,F{k},circle,{x},{y},{z},{i},{j},{kk},{2 * f['radius_mm']},1.1,12")
+    else:
+        rows.append(f"1,F{k},plane,{x},{y},{z},{i},{j},{kk},,2.4,12")
+put("feature_actuals", "ttp_nominal_foreign_ids.csv", FA + "\n".join(rows) + "\n")
+put("feature_actuals", "sphere_centres.csv", FA + "1,S1,sphere,-160,0,75,,,,30,0.5,25\n1,S2,sphere,0,160,75,,,,30,,25\n")
+put("feature_actuals", "hostile_rows.csv", FA + "1,TOP,plane,nan,0,0,0,0,1,,1,12\n1,CYL,circle,0,0,0,0,0,0,-5,,1e300\n"
+    "2,Z1,plane,0,0,-12,0,0,1,,,3\n1,FLANK_P,plane,1e308,1e308,1e308,1e-300,0,0,,inf,9\n1,X,cone,0,0,0,,,,,,1\n")
+put("feature_actuals", "hostile_ambiguous.csv", FA + "".join(f"1,P{k},plane,0,{-6.0 + 1e-9 * k},-12.1,0,0,1,,1,12\n" for k in range(50)))
+
 # --- QIF, DMIS ----------------------------------------------------------------------------------
 for f in ("QIF_Results_Sample.QIF", "mitutoyo_results_serialized_pass_fail_sample.QIF"):
     copy("qif", os.path.join(ROOT, "..", "shared", "refdata", "qif3", "samples", f))
