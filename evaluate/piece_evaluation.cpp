@@ -14,8 +14,10 @@
 #include "core/error.hpp"
 #include "core/input_file.hpp"
 #include "evaluate/feature_actuals.hpp"
+#include "interop/dmis.hpp"
 #include "interop/qif.hpp"
 #include "evaluate/ingest.hpp"
+#include "evaluate/sw_features.hpp"
 #include "evaluate/ttp_ingest.hpp"
 
 namespace probeloop::evaluate {
@@ -138,14 +140,43 @@ EvaluationFiles steppedWorkpiece(const parts::PlanManifest& m, const EvaluateReq
     throw InputError(r.input_file, 0, "the stepped workpiece is evaluated from its CMM export and its on-machine probe "
                                       "log together: give the log with --probe-log (seed 000 L761: CMM - probe)");
   const std::string text = readFile(r.input_file);
-  const std::string fmt = r.format == "auto" ? detectTtpFormat(r.input_file, text) : r.format;
-  if (fmt != "cmm" && fmt != "qif" && fmt != "dmis")
-    throw InputError(r.input_file, 0, "expected the CMM export (feature,point,x_mm,y_mm,z_mm,..., QIF 3.0 Results or DMIS output), found a " + fmt + " file");
+  // A feature-actuals CSV (auto: its header) is the stated-features route; before the CSV
+  // sniffing, which would take its time_s column for the on-machine points CSV.
+  const bool feature_csv = r.format == "features" || (r.format == "auto" && looksLikeFeatureActuals(text));
+  const std::string fmt = feature_csv ? "features" : r.format == "auto" ? detectTtpFormat(r.input_file, text) : r.format;
+  if (fmt != "cmm" && fmt != "qif" && fmt != "dmis" && fmt != "features")
+    throw InputError(r.input_file, 0, "expected the CMM export (feature,point,x_mm,y_mm,z_mm,..., QIF 3.0 Results or DMIS output) or "
+                                      "its feature actuals, found a " + fmt + " file");
   const std::string log = readFile(r.probe_log);
   const std::string log_fmt = detectTtpFormat(r.probe_log, log);
   if (log_fmt == "cmm" || log_fmt == "gauge" || log_fmt == "qif" || log_fmt == "dmis")
     throw InputError(r.probe_log, 0, "--probe-log: expected the on-machine probe log (PT lines) or points CSV, found a " + log_fmt + " file");
   EvaluationFiles f;
+  // A QIF/DMIS file with measured features and not one point: the stated planes (sw_features.hpp);
+  // with points, the point route as before.
+  std::optional<interop::CmmDocument> doc;
+  if (fmt == "qif" || fmt == "dmis") {
+    const interop::CmmReadOptions options{r.strict};
+    doc = fmt == "qif" ? interop::parseQifResults(text, r.input_file, options) : interop::parseDmisOutput(text, r.input_file, options);
+    if (!holdsOnlyFeatures(*doc)) doc.reset();
+  }
+  if (feature_csv || doc) {
+    const auto rows = doc ? featureActualsFromCmm(*doc) : parseFeatureActuals(text, r.input_file);
+    f.stepped_workpiece = evaluateSteppedWorkpieceFromFeatures(m, rows, swPlannedCmmPoints(m), r.input_file, fmt,
+                                                               readTtpOnMachine(r.probe_log, log, log_fmt, m));
+    if (!r.compare_with.empty()) compareWithBefore(*f.stepped_workpiece, m, r.compare_with);
+    const auto& e = *f.stepped_workpiece;
+    f.errors_csv = swErrorsCsv(e);
+    f.evaluation_json = swEvaluationJson(e);
+    f.report_md = swReport(e);
+    f.compensation_json = swCompensationFile(e);
+    f.results_qif = evaluationQif(m, nullptr, f.errors_csv);  // no measured points to write
+    std::vector<std::string> warnings;
+    if (doc)
+      for (const auto& w : doc->warnings) warnings.push_back(r.input_file + ":" + std::to_string(w.line) + ": " + w.what);
+    f.stdout_text = swFromFeaturesStdout(*e.from_features) + swStdout(e, r.out_dir) + warningLines(warnings);
+    return f;
+  }
   const auto cmm = readTtpCmmExport(r.input_file, text, m, r.strict);
   f.stepped_workpiece = evaluateSteppedWorkpiece(m, cmm, readTtpOnMachine(r.probe_log, log, log_fmt, m));
   if (!r.compare_with.empty()) compareWithBefore(*f.stepped_workpiece, m, r.compare_with);
