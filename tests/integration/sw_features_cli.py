@@ -59,34 +59,39 @@ def evaluate(cmm, out, *extra):
 
 
 def ratios(ev_f, ev_p):
-    """Per quantity the largest |features - points| / sqrt(U_points^2 + U_features^2) over the steps."""
+    """Per quantity the largest |features - points| / sqrt(U_points^2 + U_features^2) over the
+    steps, and the range of U_features / U_points over every value."""
     r = {}
+    u = []
 
-    def put(name, d, U):
+    def put(name, d, U, Uf=None, Up=None):
         r[name] = max(r.get(name, 0.0), abs(d) / U if U > 0 else math.inf)
+        if Uf is not None and Up > 0:
+            u.append(Uf / Up)
 
     for sf, sp in zip(ev_f["separation"], ev_p["separation"]):
         for q in SEPARATED:
-            put(q, sf[q]["value"] - sp[q]["value"], math.hypot(sf[q]["U"], sp[q]["U"]))
+            put(q, sf[q]["value"] - sp[q]["value"], math.hypot(sf[q]["U"], sp[q]["U"]), sf[q]["U"], sp[q]["U"])
     for a in "xyz":
         q = f"k_pos_{a}_um_per_mm"
-        put(q, ev_f[q]["value"] - ev_p[q]["value"], math.hypot(ev_f[q]["U"], ev_p[q]["U"]))
+        put(q, ev_f[q]["value"] - ev_p[q]["value"], math.hypot(ev_f[q]["U"], ev_p[q]["U"]), ev_f[q]["U"], ev_p[q]["U"])
     for gf, gp, sf, sp in zip(ev_f["cmm"]["steps"], ev_p["cmm"]["steps"], ev_f["separation"], ev_p["separation"]):
         for q, uq in GEOMETRY:
             if uq is None:  # the CMM's width/depth: its u (MPE, planes, temperature) x 2
                 key = {"width_x_error_um": "u_cmm_width_x_um", "width_y_error_um": "u_cmm_width_y_um",
                        "depth_error_um": "u_cmm_depth_um"}[q]
-                U = math.hypot(2 * sf[key], 2 * sp[key])
+                Uf, Up = 2 * sf[key], 2 * sp[key]
             else:
-                U = math.hypot(gf[uq], gp[uq])
-            put("cmm " + q, gf[q] - gp[q], U)
-    return r
+                Uf, Up = gf[uq], gp[uq]
+            put("cmm " + q, gf[q] - gp[q], math.hypot(Uf, Up), Uf, Up)
+    return r, (min(u), max(u))
 
 
 def agrees(label, ev_f, ev_p):
-    r = ratios(ev_f, ev_p)
+    r, (lo, hi) = ratios(ev_f, ev_p)
     print(f"     {label}: largest |features - points| / sqrt(U_points^2 + U_features^2) over the 4 steps:")
     print("       " + ", ".join(f"{q} {v:.3f}" for q, v in r.items()))
+    print(f"       U_features / U_points from {lo:.3f} to {hi:.3f}")
     check(f"{label}: every value within the combined U of the point route's (largest ratio {max(r.values()):.3f})",
           all(v <= 1 for v in r.values()), r)
 
