@@ -62,6 +62,15 @@ Contribution contribution(std::string input, char type, std::string dist, std::s
   return c;
 }
 
+// The CMM term of a width or depth from stated planes (evaluate/sw_features.hpp): type A with the
+// form's n - 3 dof when a plane's sigma came from its form, else type B (the MPE, a stated u).
+Contribution statedPlanes(const SwSourceGeometry& g, const std::string& id1, const std::string& id2, double u) {
+  double dof = std::numeric_limits<double>::infinity();
+  for (const SwPlane* p : {&plane(g, id1), &plane(g, id2)})
+    if (!p->slope_u_from_spec) dof = std::min(dof, static_cast<double>(std::max(1, p->points - 3)));
+  return contribution("CMM planes as stated", std::isfinite(dof) ? 'A' : 'B', "normal", g.stated_basis, u, dof);
+}
+
 }  // namespace
 
 std::vector<SwPlane> swPlanes(const parts::PlanManifest& m, const TtpPoints& pts, const std::function<double(double)>& point_u_um) {
@@ -305,9 +314,11 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, SwSourceGeom
           contribution("probe repeatability", type_a ? 'A' : 'B', "normal", rep_basis, u_rep, dof_pt),
           contribution("CMM length measurement", 'B', "rectangular", "MPE " + formatNumber(mpe(L), 3) + " um at " + formatNumber(L) + " mm",
                        mpe(L) / kSqrt3),
-          contribution(e.cmm.stated_basis.empty() ? "CMM plane fits" : "CMM planes as stated", 'A', "normal",
-                       e.cmm.stated_basis.empty() ? "s of the residuals / sqrt(n) of both planes" : e.cmm.stated_basis, u_fit_cmm,
-                       std::max(1, count(e.cmm, a == 2 ? "TOP" : stepId(k, a == 0 ? "XP" : "YP")) - 3)),
+          e.cmm.stated_basis.empty()
+              ? contribution("CMM plane fits", 'A', "normal", "s of the residuals / sqrt(n) of both planes", u_fit_cmm,
+                             std::max(1, count(e.cmm, a == 2 ? "TOP" : stepId(k, a == 0 ? "XP" : "YP")) - 3))
+              : statedPlanes(e.cmm, a == 2 ? "TOP" : stepId(k, a == 0 ? "XP" : "YP"),
+                             a == 2 ? stepId(k, "F") : stepId(k, a == 0 ? "XN" : "YN"), u_fit_cmm),
           contribution("part temperature at the CMM", 'B', "rectangular",
                        "20 C +- " + formatNumber(dT_cmm) + " K, not corrected", alpha * L * dT_cmm / kSqrt3),
           contribution("part temperature on the machine", 'B', "rectangular",

@@ -159,7 +159,8 @@ std::string swFromFeaturesReport(const SwFromFeatures& f) {
 
 std::string swFromFeaturesStdout(const SwFromFeatures& f) {
   std::string o = "CMM planes from the stated features of " + f.file + " (no points; " + std::to_string(f.planes.size()) +
-                  " planes matched by " + f.assigned_by + ", " + std::to_string(f.unmatched.size()) + " rows fit no plane, " +
+                  " planes matched by " + f.assigned_by + ", " + std::to_string(f.unmatched.size()) +
+                  (f.unmatched.size() == 1 ? " row fits" : " rows fit") + " no plane, " +
                   std::to_string(f.other_kinds) + " rows of other kinds not used)\n";
   for (const auto& u : f.unmatched) o += "  " + u + "\n";
   return o;

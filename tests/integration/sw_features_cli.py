@@ -157,7 +157,7 @@ try:
     csv = write("features.csv", "\n".join(lines) + "\n")
     code, out, err = evaluate(csv, "csv")
     check("(b) the feature CSV (auto-detected): 21 planes matched by nominal geometry, the alignment row listed",
-          code == 0 and "21 planes matched by nominal geometry, 1 rows fit no plane" in out and
+          code == 0 and "21 planes matched by nominal geometry, 1 row fits no plane" in out and
           f"{csv}:23: plane 'ALIGN_Z' fits no plane of the plan (nearest TOP, 40 mm): not used" in out, out + err)
     ev_b = json.load(open(f"{W}/csv/evaluation.json")) if code == 0 else ev_p
     agrees("(b) feature CSV, foreign ids", ev_b, ev_p)
@@ -190,8 +190,10 @@ try:
           out + err)
     ev_c = json.load(open(f"{W}/dmis/evaluation.json")) if code == 0 else ev_p
     agrees("(c) DMIS FA actuals", ev_c, ev_p)
-    check("(c) DMIS states no form: every plane's sigma is the MPE's",
-          all(p["sigma_from"] == "MPE" and p["form_um"] is None for p in ev_c["cmm"]["from_features"]["planes"]))
+    check("(c) DMIS states no form: every plane's sigma is the MPE's, the e_pos terms type B (no dof)",
+          all(p["sigma_from"] == "MPE" and p["form_um"] is None for p in ev_c["cmm"]["from_features"]["planes"]) and
+          all(c["type"] == "B" and c["dof"] is None for s in ev_c["separation"] for q in ("e_pos_x_um", "e_pos_z_um")
+              for c in s[q]["contributions"] if c["input"] == "CMM planes as stated"))
 
     # --- refusals -------------------------------------------------------------------------------
     body = open(csv).read().splitlines()
