@@ -143,6 +143,15 @@ std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, 
   return out;
 }
 
+bool holdsOnlyFeatures(const interop::CmmDocument& d) {
+  bool any_geometry = false;
+  for (const auto& f : d.features) {
+    if (!f.points.empty()) return false;
+    any_geometry = any_geometry || f.measured.given;
+  }
+  return any_geometry;
+}
+
 std::optional<StatedFeatureFile> readStatedFeatures(const std::string& path, const std::string& text, bool strict) {
   StatedFeatureFile out;
   if (looksLikeFeatureActuals(text)) {
@@ -154,9 +163,7 @@ std::optional<StatedFeatureFile> readStatedFeatures(const std::string& path, con
   if (!qif && (!interop::looksLikeDmis(text) || interop::isDmisProgram(text))) return std::nullopt;
   const interop::CmmReadOptions options{strict};
   const auto d = qif ? interop::parseQifResults(text, path, options) : interop::parseDmisOutput(text, path, options);
-  bool points = false, geometry = false;
-  for (const auto& f : d.features) points |= !f.points.empty(), geometry |= f.measured.given;
-  if (points || !geometry) return std::nullopt;
+  if (!holdsOnlyFeatures(d)) return std::nullopt;
   if (d.runs > 1)
     throw InputError(path, 0, std::to_string(d.runs) + " MeasurementResults (runs) in one file: the piece is measured once; write "
                                                       "each run to its own file");

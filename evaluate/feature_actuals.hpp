@@ -62,6 +62,8 @@ bool looksLikeFeatureActuals(const std::string& text);
 // points (the point route reads it) or is neither. A QIF with several MeasurementResults is
 // refused (the piece is measured once). warnings: the lenient reader's, "file:line: what"; strict
 // refuses them instead.
+// True when a QIF/DMIS document carries measured features but not one point: the feature route.
+bool holdsOnlyFeatures(const interop::CmmDocument& d);
 struct StatedFeatureFile {
   std::string format;  // features | qif | dmis
   std::vector<FeatureActual> rows;

@@ -16,6 +16,7 @@
 #include "evaluate/feature_actuals.hpp"
 #include "interop/qif.hpp"
 #include "evaluate/ingest.hpp"
+#include "evaluate/sw_features.hpp"
 #include "evaluate/ttp_ingest.hpp"
 
 namespace probeloop::evaluate {
@@ -97,6 +98,14 @@ std::string warningLines(const std::vector<std::string>& warnings) {
   return o;
 }
 
+// The features a CMM states, when the file holds no points (issue 34): a feature CSV, or a QIF /
+// DMIS file of features only; nullopt: the point route.
+std::optional<StatedFeatureFile> statedFeatures(const std::string& fmt, const EvaluateRequest& r, const std::string& text) {
+  if (fmt == "features") return StatedFeatureFile{"features", parseFeatureActuals(text, r.input_file), {}};
+  if (fmt == "qif" || fmt == "dmis") return readStatedFeatures(r.input_file, text, r.strict);
+  return std::nullopt;
+}
+
 EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateRequest& r) {
   if (r.free_radius) throw InputError(r.input_file, 0, "--free-radius applies to sphere-artifact campaigns, not to the thermal test piece");
   const std::string text = readFile(r.input_file);
@@ -107,11 +116,7 @@ EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateReq
   std::optional<TtpPoints> points;
   std::vector<std::string> warnings;
   // Only the fitted features, no points (issue 34): the plan's points placed on them.
-  std::optional<StatedFeatureFile> stated;
-  if (fmt == "features")
-    stated = StatedFeatureFile{"features", parseFeatureActuals(text, r.input_file), {}};
-  else if (fmt == "qif" || fmt == "dmis")
-    stated = readStatedFeatures(r.input_file, text, r.strict);
+  const auto stated = statedFeatures(fmt, r, text);
   if (stated) {
     e = evaluateThermalTestPieceFromFeatures(m, stated->rows, r.input_file, stated->format, opt);
     warnings = stated->warnings;
@@ -150,13 +155,29 @@ EvaluationFiles steppedWorkpiece(const parts::PlanManifest& m, const EvaluateReq
                                       "log together: give the log with --probe-log (seed 000 L761: CMM - probe)");
   const std::string text = readFile(r.input_file);
   const std::string fmt = r.format == "auto" ? detectTtpFormat(r.input_file, text) : r.format;
-  if (fmt != "cmm" && fmt != "qif" && fmt != "dmis")
-    throw InputError(r.input_file, 0, "expected the CMM export (feature,point,x_mm,y_mm,z_mm,..., QIF 3.0 Results or DMIS output), found a " + fmt + " file");
+  if (fmt != "cmm" && fmt != "qif" && fmt != "dmis" && fmt != "features")
+    throw InputError(r.input_file, 0, "expected the CMM export (feature,point,x_mm,y_mm,z_mm,..., QIF 3.0 Results or DMIS output) or "
+                                      "its feature actuals, found a " + fmt + " file");
   const std::string log = readFile(r.probe_log);
   const std::string log_fmt = detectTtpFormat(r.probe_log, log);
-  if (log_fmt == "cmm" || log_fmt == "gauge" || log_fmt == "qif" || log_fmt == "dmis")
+  if (log_fmt == "cmm" || log_fmt == "gauge" || log_fmt == "qif" || log_fmt == "dmis" || log_fmt == "features")
     throw InputError(r.probe_log, 0, "--probe-log: expected the on-machine probe log (PT lines) or points CSV, found a " + log_fmt + " file");
   EvaluationFiles f;
+  // Only the fitted planes, no points: the stated planes (sw_features.hpp); with points, the
+  // point route as before.
+  if (const auto stated = statedFeatures(fmt, r, text)) {
+    f.stepped_workpiece = evaluateSteppedWorkpieceFromFeatures(m, stated->rows, swPlannedCmmPoints(m), r.input_file, stated->format,
+                                                               readTtpOnMachine(r.probe_log, log, log_fmt, m));
+    if (!r.compare_with.empty()) compareWithBefore(*f.stepped_workpiece, m, r.compare_with);
+    const auto& e = *f.stepped_workpiece;
+    f.errors_csv = swErrorsCsv(e);
+    f.evaluation_json = swEvaluationJson(e);
+    f.report_md = swReport(e);
+    f.compensation_json = swCompensationFile(e);
+    f.results_qif = evaluationQif(m, nullptr, f.errors_csv);  // no measured points to write
+    f.stdout_text = swFromFeaturesStdout(*e.from_features) + swStdout(e, r.out_dir) + warningLines(stated->warnings);
+    return f;
+  }
   const auto cmm = readTtpCmmExport(r.input_file, text, m, r.strict);
   f.stepped_workpiece = evaluateSteppedWorkpiece(m, cmm, readTtpOnMachine(r.probe_log, log, log_fmt, m));
   if (!r.compare_with.empty()) compareWithBefore(*f.stepped_workpiece, m, r.compare_with);

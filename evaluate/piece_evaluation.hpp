@@ -5,7 +5,8 @@
 // Kinds: sphere_artifact (seed 004 Ch. 5: evaluate/sphere_campaign.hpp; the writers of
 // evaluate/outputs.cpp, as before the dispatch), thermal_test_piece (seed 004 Ch. 7:
 // evaluate/thermal_test_piece.hpp) and stepped_workpiece (seed 000: its CMM export and probe
-// log together, evaluate/stepped_workpiece.hpp).
+// log together, evaluate/stepped_workpiece.hpp; when the CMM file is a feature-actuals CSV or a
+// QIF/DMIS file with features and no points, from the stated planes, evaluate/sw_features.hpp).
 #pragma once
 #include <optional>
 #include <string>
@@ -19,7 +20,8 @@ namespace probeloop::evaluate {
 
 struct EvaluateRequest {
   std::string input_file;
-  // auto | linuxcnc | fanuc | csv (both kinds) | cmm | gauge (thermal test piece)
+  // auto | linuxcnc | fanuc | csv (both kinds) | cmm | gauge (thermal test piece) | features
+  // (sphere artifact, stepped workpiece) | qif | dmis
   std::string format = "auto";
   bool free_radius = false;      // sphere artifact: centres from the free-radius fit
   std::string compare_with;      // thermal test piece: another evaluation.json -> Table 7.2 reductions

@@ -10,6 +10,7 @@
 #include "core/csv.hpp"
 #include "core/error.hpp"
 #include "evaluate/budget_json.hpp"
+#include "evaluate/sw_features.hpp"
 #include "geometry/fit.hpp"
 #include "uncertainty/gum.hpp"
 #include "parts/sw_compensation.hpp"
@@ -61,13 +62,19 @@ Contribution contribution(std::string input, char type, std::string dist, std::s
   return c;
 }
 
+// The CMM term of a width or depth from stated planes (evaluate/sw_features.hpp): type A with the
+// form's n - 3 dof when a plane's sigma came from its form, else type B (the MPE, a stated u).
+Contribution statedPlanes(const SwSourceGeometry& g, const std::string& id1, const std::string& id2, double u) {
+  double dof = std::numeric_limits<double>::infinity();
+  for (const SwPlane* p : {&plane(g, id1), &plane(g, id2)})
+    if (!p->slope_u_from_spec) dof = std::min(dof, static_cast<double>(std::max(1, p->points - 3)));
+  return contribution("CMM planes as stated", std::isfinite(dof) ? 'A' : 'B', "normal", g.stated_basis, u, dof);
+}
+
 }  // namespace
 
-SwSourceGeometry steppedGeometry(const parts::PlanManifest& m, const TtpPoints& pts, const std::string& route,
-                                 const std::function<double(double)>& point_u_um) {
-  SwSourceGeometry g;
-  g.file = pts.file;
-  g.route = route;
+std::vector<SwPlane> swPlanes(const parts::PlanManifest& m, const TtpPoints& pts, const std::function<double(double)>& point_u_um) {
+  std::vector<SwPlane> planes;
   // Repeated touches of one planned point (step 3's walls, L769) are averaged: the fit takes
   // each place once (points of a feature closer than 0.05 mm are one place; planned points are
   // millimetres apart).
@@ -132,12 +139,23 @@ SwSourceGeometry steppedGeometry(const parts::PlanManifest& m, const TtpPoints& 
       }
       if (std::fabs(M.determinant()) > 1e-12 * std::max(1.0, M.squaredNorm())) {
         const Eigen::Matrix2d C = M.inverse();
-        p.u_slope[i] = u_pt * 1e-3 * std::sqrt(C(0, 0));
-        p.u_slope[j] = u_pt * 1e-3 * std::sqrt(C(1, 1));
+        p.slope_lever[i] = std::sqrt(C(0, 0));
+        p.slope_lever[j] = std::sqrt(C(1, 1));
+        p.u_slope[i] = u_pt * 1e-3 * p.slope_lever[i];
+        p.u_slope[j] = u_pt * 1e-3 * p.slope_lever[j];
       }
     }
-    g.planes.push_back(p);
+    planes.push_back(p);
   }
+  return planes;
+}
+
+SwSourceGeometry swGeometryFromPlanes(const parts::PlanManifest& m, std::vector<SwPlane> planes, const std::string& file,
+                                      const std::string& route) {
+  SwSourceGeometry g;
+  g.file = file;
+  g.route = route;
+  g.planes = std::move(planes);
   const SwPlane& top = plane(g, "TOP");
   for (std::size_t i = 0; i < m.sw.sizes_mm.size(); ++i) {
     const int k = static_cast<int>(i) + 1;
@@ -190,6 +208,11 @@ SwSourceGeometry steppedGeometry(const parts::PlanManifest& m, const TtpPoints& 
   return g;
 }
 
+SwSourceGeometry steppedGeometry(const parts::PlanManifest& m, const TtpPoints& pts, const std::string& route,
+                                 const std::function<double(double)>& point_u_um) {
+  return swGeometryFromPlanes(m, swPlanes(m, pts, point_u_um), pts.file, route);
+}
+
 SwRepeatability probeRepeatability(const parts::PlanManifest& m, const TtpPoints& probe) {
   // (feature, point) -> nominal contact and approach
   std::map<std::pair<std::string, int>, const parts::ManifestPoint*> plan;
@@ -225,17 +248,32 @@ SwRepeatability probeRepeatability(const parts::PlanManifest& m, const TtpPoints
   return r;
 }
 
-SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoints& cmm, const TtpPoints& probe) {
+namespace {
+void requireSteppedPlan(const parts::PlanManifest& m) {
   if (parts::parsePieceKind(m.kind) != parts::PieceKind::SteppedWorkpiece)
     throw InputError(m.file, 0, "kind: '" + m.kind + "': the stepped-workpiece evaluation needs a stepped_workpiece plan");
+}
+}  // namespace
+
+std::function<double(double)> swCmmPointU(const parts::PlanManifest& m) {
+  const double mpe0 = m.sw.cmm.mpe_constant_um, mpeK = m.sw.cmm.mpe_length_mm;
+  return [mpe0, mpeK](double L) { return (mpe0 + (mpeK > 0 ? L / mpeK : 0.0)) / kSqrt3; };
+}
+
+SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoints& cmm, const TtpPoints& probe) {
+  requireSteppedPlan(m);
+  return evaluateSteppedWorkpiece(m, steppedGeometry(m, cmm, "cmm", swCmmPointU(m)), probe);
+}
+
+SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, SwSourceGeometry cmm, const TtpPoints& probe) {
+  requireSteppedPlan(m);
   SwEvaluation e;
   e.experiment = m.sw.experiment;
   e.transition = m.sw.transition;
   e.transition_feed_mm_per_min = m.sw.transition_feed_mm_per_min;
   e.applied = m.sw.compensation;
   const auto rep = probeRepeatability(m, probe);
-  const double mpe0 = m.sw.cmm.mpe_constant_um, mpeK = m.sw.cmm.mpe_length_mm;
-  e.cmm = steppedGeometry(m, cmm, "cmm", [&](double L) { return (mpe0 + (mpeK > 0 ? L / mpeK : 0.0)) / kSqrt3; });
+  e.cmm = std::move(cmm);
   const double s_probe = rep.pairs >= 2 ? rep.s_um : m.probe_repeatability_2sigma_um / 2;
   e.probe = steppedGeometry(m, probe, "on_machine", [&](double) { return s_probe; });
   e.probe_repeat_pairs = rep.pairs;
@@ -276,8 +314,11 @@ SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoi
           contribution("probe repeatability", type_a ? 'A' : 'B', "normal", rep_basis, u_rep, dof_pt),
           contribution("CMM length measurement", 'B', "rectangular", "MPE " + formatNumber(mpe(L), 3) + " um at " + formatNumber(L) + " mm",
                        mpe(L) / kSqrt3),
-          contribution("CMM plane fits", 'A', "normal", "s of the residuals / sqrt(n) of both planes", u_fit_cmm,
-                       std::max(1, count(e.cmm, a == 2 ? "TOP" : stepId(k, a == 0 ? "XP" : "YP")) - 3)),
+          e.cmm.stated_basis.empty()
+              ? contribution("CMM plane fits", 'A', "normal", "s of the residuals / sqrt(n) of both planes", u_fit_cmm,
+                             std::max(1, count(e.cmm, a == 2 ? "TOP" : stepId(k, a == 0 ? "XP" : "YP")) - 3))
+              : statedPlanes(e.cmm, a == 2 ? "TOP" : stepId(k, a == 0 ? "XP" : "YP"),
+                             a == 2 ? stepId(k, "F") : stepId(k, a == 0 ? "XN" : "YN"), u_fit_cmm),
           contribution("part temperature at the CMM", 'B', "rectangular",
                        "20 C +- " + formatNumber(dT_cmm) + " K, not corrected", alpha * L * dT_cmm / kSqrt3),
           contribution("part temperature on the machine", 'B', "rectangular",
@@ -517,6 +558,17 @@ std::string swEvaluationJson(const SwEvaluation& e) {
     return s;
   };
   j["cmm"] = geom(e.cmm);
+  if (e.from_features) {  // the CMM planes as a file stated them (evaluate/sw_features.hpp)
+    const auto& f = *e.from_features;
+    nlohmann::ordered_json x{{"file", f.file}, {"format", f.format}, {"assigned_by", f.assigned_by}, {"basis", e.cmm.stated_basis}};
+    for (const auto& p : f.planes)
+      x["planes"].push_back({{"id", p.id}, {"row", p.row}, {"matched_by", p.matched_by}, {"n_stated", p.n_stated},
+                             {"n_planned", p.n_planned}, {"form_um", std::isfinite(p.form_um) ? nlohmann::ordered_json(p.form_um) : nullptr},
+                             {"sigma_um", p.sigma_um}, {"sigma_from", p.sigma_from}});
+    x["unmatched"] = f.unmatched;
+    x["rows_of_other_kinds_not_used"] = f.other_kinds;
+    j["cmm"]["from_features"] = x;
+  }
   j["on_machine"] = geom(e.probe);
   j["probe_repeatability_um"] = e.probe_repeatability_um;
   j["probe_repeat_pairs"] = e.probe_repeat_pairs;
@@ -575,6 +627,7 @@ std::string swReport(const SwEvaluation& e) {
     << ", k_z = " << bu(e.k_pos_z_um_per_mm) << " um/mm. Probe repeatability (1 sigma, one point): "
     << num(e.probe_repeatability_um, 3) << " um from " << e.probe_repeat_pairs << " repeated points.\n\n";
   for (const auto& n : e.notes) o << "- " << n << "\n";
+  if (e.from_features) o << swFromFeaturesReport(*e.from_features);
   if (!e.compared_with.empty()) {
     o << "\n## Before and after the compensation (CMM, um)\n\nBefore: " << e.compared_with
       << ". The promised fall is the compensation the plan applied (U of the prediction, k = 2).\n\n"

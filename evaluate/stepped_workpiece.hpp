@@ -34,6 +34,7 @@
 #pragma once
 #include <Eigen/Dense>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,7 @@ struct SwPlane {
   // the axis of the nominal normal): s of the residuals x sqrt of (M^-1)_ii, M the centred
   // second moments of the points' other two coordinates (type A, n - 3 dof).
   double u_slope[3] = {0, 0, 0};
+  double slope_lever[3] = {0, 0, 0};  // sqrt((M^-1)_ii), 1/mm: u_slope per mm of one point's sigma
   bool slope_u_from_spec = false;  // the specification was larger than the residual s
 };
 
@@ -74,6 +76,9 @@ struct SwStepGeometry {
 
 struct SwSourceGeometry {
   std::string file, route;  // cmm | on_machine
+  // Empty: the planes are fits of measured points. Else (evaluate/sw_features.hpp) the planes are
+  // the file's stated features and this says where each plane's sigma came from.
+  std::string stated_basis;
   std::vector<SwPlane> planes;
   std::vector<SwStepGeometry> steps;
 };
@@ -107,6 +112,22 @@ struct SwBeforeAfter {
   double before_um = 0, after_um = 0, fall_um = 0, promised_um = 0, U_promised_um = 0;
 };
 
+// The CMM side taken from a file's stated features (evaluate/sw_features.hpp): per plane what the
+// file states and the per-point sigma the budget uses; the rows that fit no plane, listed.
+struct SwStatedPlane {
+  std::string id, row, matched_by;  // manifest id; the file's id (file:line); id | nominal geometry
+  int n_stated = 0, n_planned = 0;  // n_stated 0: not stated
+  double form_um = 0;               // NaN: not stated
+  double sigma_um = 0;              // per measured point, the largest of what is stated
+  std::string sigma_from;           // "form" | "MPE" | "stated u"
+};
+struct SwFromFeatures {
+  std::string file, format, assigned_by;
+  std::vector<SwStatedPlane> planes;
+  std::vector<std::string> unmatched;  // "file:line: kind 'id' fits no plane (nearest ..., d mm)"
+  int other_kinds = 0;
+};
+
 struct SwEvaluation {
   std::string experiment;
   // How the walls were joined (the manifest's: non_cutting | fast | continuous) and at what feed
@@ -124,6 +145,7 @@ struct SwEvaluation {
   // The offsets the plan applied (its manifest's compensation; empty: none), written to
   // evaluation.json so that a later --compare promises only the change between the two plans.
   std::vector<parts::SwStepCompensation> applied;
+  std::optional<SwFromFeatures> from_features;  // the CMM side from stated features, not points
 };
 
 // point_u_um(L): the route's specified standard uncertainty of one point at distance L (mm) from
@@ -132,6 +154,14 @@ struct SwEvaluation {
 // n - 3 dof). Absent: the residual alone.
 SwSourceGeometry steppedGeometry(const parts::PlanManifest& m, const TtpPoints& points, const std::string& route,
                                  const std::function<double(double)>& point_u_um = {});
+// Its two halves: the planes fitted to the points, then the steps from the planes (InputError
+// naming a plane the manifest plans that has no points).
+std::vector<SwPlane> swPlanes(const parts::PlanManifest& m, const TtpPoints& points,
+                              const std::function<double(double)>& point_u_um = {});
+SwSourceGeometry swGeometryFromPlanes(const parts::PlanManifest& m, std::vector<SwPlane> planes, const std::string& file,
+                                      const std::string& route);
+// The CMM's specified standard uncertainty of one point at L mm from the part origin: MPE(L)/sqrt 3.
+std::function<double(double)> swCmmPointU(const parts::PlanManifest& m);
 
 // The manifest's repeated probe points (same feature, same nominal contact): s of one point.
 struct SwRepeatability {
@@ -141,6 +171,8 @@ struct SwRepeatability {
 SwRepeatability probeRepeatability(const parts::PlanManifest& m, const TtpPoints& probe);
 
 SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, const TtpPoints& cmm, const TtpPoints& probe);
+// The same from the CMM side's geometry already built (the stated-features route).
+SwEvaluation evaluateSteppedWorkpiece(const parts::PlanManifest& m, SwSourceGeometry cmm, const TtpPoints& probe);
 
 // Fills before_after from the earlier evaluation.json (InputError naming the file when it is
 // not a stepped-workpiece evaluation of the same experiment and steps) and the manifest's

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """The thermal test piece evaluated from the features a CMM states, without points (issue 34
-item 3; docs/thermal-test-piece-evaluation.md §8).
+item 3; docs/thermal-test-piece-evaluation.md §10).
 
 plan the shipped piece (20 min between cycles) on the NMV 5000 -> simulate the test and the CMM
 (its QIF 3.0 Results and DMIS output, features and points) -> evaluate the point route from the
