@@ -62,12 +62,17 @@ void statement(std::ostringstream& o, const std::string& s) {
   o << rest << "\n";
 }
 
+// A measured direction to 9 decimals (as the QIF writer's): at 6, a plane's normal is read to
+// 1 urad, a tenth of a um over 100 mm, and a thermal test piece's E_B is quantised to it.
+std::string ijkMeasured(const Eigen::Vector3d& d) { return fixed(d.x(), 9) + "," + fixed(d.y(), 9) + "," + fixed(d.z(), 9); }
+
 std::string featureStatement(const std::string& prefix, const CmmFeature& f, const CmmGeometry& g) {
   const std::string l = prefix + "(" + label(f.name) + ")=FEAT/";
+  const std::string dir = prefix == "FA" ? ijkMeasured(g.direction) : ijk(g.direction);
   switch (f.kind) {
-    case CmmFeatureKind::Plane: return l + "PLANE,CART," + xyz(g.location_mm) + "," + ijk(g.direction);
+    case CmmFeatureKind::Plane: return l + "PLANE,CART," + xyz(g.location_mm) + "," + dir;
     case CmmFeatureKind::Cylinder:
-      return l + "CYLNDR," + (f.internal ? "INNER" : "OUTER") + ",CART," + xyz(g.location_mm) + "," + ijk(g.direction) + "," +
+      return l + "CYLNDR," + (f.internal ? "INNER" : "OUTER") + ",CART," + xyz(g.location_mm) + "," + dir + "," +
              fixed(g.diameter_mm, 6);
     case CmmFeatureKind::Sphere:
       return l + "SPHERE," + (f.internal ? "INNER" : "OUTER") + ",CART," + xyz(g.location_mm) + "," + fixed(g.diameter_mm, 6);
