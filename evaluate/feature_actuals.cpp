@@ -5,6 +5,7 @@
 
 #include "core/csv.hpp"
 #include "core/error.hpp"
+#include "geometry/fit.hpp"
 #include "interop/dmis.hpp"
 #include "interop/qif.hpp"
 
@@ -124,9 +125,32 @@ std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, 
     f.cycle = std::max(c.run, 1);
     f.id = c.name;
     f.kind = interop::cmmFeatureKindName(c.kind);
-    if (c.kind == interop::CmmFeatureKind::Sphere && !c.measured.given)
-      throw InputError(d.file, c.line, "sphere '" + c.name + "' has no measured Location (points only): the sphere artifact is "
-                                       "evaluated here from the centres the CMM reports");
+    if (c.kind == interop::CmmFeatureKind::Sphere && !c.measured.given) {
+      // Points only: the centre the CMM software would have stated, from them (issue 34 item 2).
+      if (c.points.size() < 4)
+        throw InputError(d.file, c.line, "sphere '" + c.name + "' has no measured Location and " + std::to_string(c.points.size()) +
+                                             " points: a sphere's centre needs its Location or at least 4 points");
+      geometry::Points3 p;
+      for (const auto& q : c.points) p.push_back(q.p_mm);
+      geometry::FitResult fit;
+      try {
+        fit = geometry::fitElement(geometry::ElementKind::Sphere, p, {}).fit;
+      } catch (const GeometryError& x) {
+        throw InputError(d.file, c.line, "sphere '" + c.name + "' (points only): " + x.what());
+      }
+      f.fitted_here = true;
+      f.has_geometry = true;
+      f.location_mm = fit.element.position_mm;
+      f.size_mm = 2 * fit.element.radius_mm;
+      f.form_um = fit.form_mm * 1e3;
+      f.n_points = static_cast<int>(p.size());
+      if (max_cycle > 0 && f.cycle > max_cycle)
+        throw InputError(d.file, c.line, "measurement run " + std::to_string(f.cycle) + " (a cycle) is beyond the plan's " +
+                                             std::to_string(max_cycle) + " cycles");
+      checkPlausible(f);
+      out.push_back(std::move(f));
+      continue;
+    }
     if (max_cycle > 0 && f.cycle > max_cycle)
       throw InputError(d.file, c.line, "measurement run " + std::to_string(f.cycle) + " (a cycle) is beyond the plan's " +
                                            std::to_string(max_cycle) + " cycles");

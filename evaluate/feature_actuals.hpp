@@ -40,6 +40,7 @@ struct FeatureActual {
   std::optional<Eigen::Vector3d> u_um;  // the CMM's stated standard uncertainty per coordinate
   std::optional<double> time_s;
   bool has_geometry = true;  // false: a QIF/DMIS feature with points but no measured geometry
+  bool fitted_here = false;  // a sphere of points only: its centre fitted here (featureActualsFromCmm)
 };
 
 // max_cycle > 0 refuses a cycle beyond it (the plan's cycles).
@@ -48,9 +49,11 @@ std::vector<FeatureActual> parseFeatureActuals(const std::string& text, const st
 // The measured features of a QIF 3.0 Results or DMIS output document (interop's readers) as
 // feature actuals: the cycle is the document's measurement run (QIF: the MeasurementResults in
 // order; DMIS output: 1), the id the feature's name, size and form as the file states them,
-// n_points the points it carries (0: none exported). A sphere without measured geometry (points
-// only) is refused with its line: this route reads the CMM's centres. Cycles beyond max_cycle
-// (> 0) are refused.
+// n_points the points it carries (0: none exported). A sphere without measured geometry but with
+// points (a QIF or DMIS export of points only) gets its centre here: the least-squares sphere of
+// its points (free radius; form = the range of the residuals; fitted_here), as the CMM software
+// would have stated it; with fewer than 4 points, or points that fix no sphere, it is refused with
+// its line. Cycles beyond max_cycle (> 0) are refused.
 std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, int max_cycle = 0);
 
 // True when a CSV text's header holds the feature-actuals columns (for --format auto).

@@ -99,6 +99,8 @@ std::string evaluationJson(const CampaignEvaluation& e, const parts::PlanManifes
         js["feature"] = {{"id", f.id},
                          {"line", f.line},
                          {"matched_by", s.stated->by_id ? "id" : "nearest nominal centre"},
+                         {"centre", f.fitted_here ? "least-squares sphere of the file's points (free radius), fitted here"
+                                                  : "as the file states it"},
                          {"diameter_mm", finiteOrNull(f.size_mm)},
                          {"form_um", finiteOrNull(f.form_um)},
                          {"n_points", f.n_points}};

@@ -12,7 +12,8 @@ that evaluation.json:
   commas and CRLF: every error agrees with the point route within the combined U
   sqrt(U_points^2 + U_features^2), and the largest difference per error is printed in units of it;
 - a QIF 3.0 Results file with only MeasuredFeatures (one MeasurementResults per cycle, the
-  point route's centres): the same errors; a sphere without its Location refused;
+  point route's centres): the same errors; the same from points only (25 per sphere, exactly
+  on a sphere about each centre: fitted here); a sphere with neither refused;
 - refusals with the file and line: an unknown kind, a missing column, two foreign rows on one
   place without time_s, a foreign row far from every sphere; a position without a centre in a
   cycle makes that cycle incomplete, listed as the point route lists it.
@@ -164,8 +165,45 @@ try:
           max(abs(bq[c][j]["value"] - bp[c][j]["value"]) for c in bp for j in range(7)) <= 1e-9, err)
     q = write("nolocation.qif", qif(ev_p, drop_location=True))
     code, out, err = run("evaluate", q, "--format", "qif", "--manifest", PLAN, "--out", f"{W}/noloc")
-    check("refused: a QIF sphere without its measured Location, with its line",
-          code == 1 and f"{q}:7:" in err and "sphere 'S2' has no measured Location" in err, err)
+    check("refused: a QIF sphere without its measured Location or points, with its line",
+          code == 1 and f"{q}:7:" in err and "sphere 'S2' has no measured Location and 0 points" in err, err)
+
+    # --- QIF 3.0 points only (issue 34 item 2): each sphere's centre fitted here to its points ---
+    def qif_points(ev):
+        out = ['<?xml version="1.0" encoding="UTF-8"?>',
+               '<QIFDocument xmlns="http://qifstandards.org/xsd/qif3" versionQIF="3.0.0" idMax="99999">',
+               f'  <Results><MeasurementResultsSet n="{len(ev["cycles"])}">']
+        i = 1000
+        for c in ev["cycles"]:
+            i += 1
+            feats, sets = [], []
+            for s in c["spheres"]:
+                i += 2
+                cx, cy, cz = s["centre_mm"]
+                pts = []
+                for k in range(25):  # a spiral over the upper hemisphere, exactly on a 15 mm sphere
+                    t = math.acos(1 - (k + 0.5) / 25)
+                    a = 2.399963 * k
+                    pts += [cx + 15 * math.sin(t) * math.cos(a), cy + 15 * math.sin(t) * math.sin(a), cz + 15 * math.cos(t)]
+                feats.append(f'<SphereFeatureMeasurement id="{i}"><FeatureName>S{s["position"]}</FeatureName><PointList n="1">'
+                             f'<WholePointSetId>{i + 1}</WholePointSetId></PointList></SphereFeatureMeasurement>')
+                sets.append(f'<MeasuredPointSet id="{i + 1}" count="25"><Points>{" ".join(repr(v) for v in pts)}</Points>'
+                            '</MeasuredPointSet>')
+            out.append(f'    <MeasurementResults id="{i + 1}"><MeasuredFeatures n="{len(feats)}">' + "".join(feats) +
+                       f'</MeasuredFeatures><MeasuredPointSets n="{len(sets)}">' + "".join(sets) +
+                       '</MeasuredPointSets></MeasurementResults>')
+            i += 1
+        out.append('  </MeasurementResultsSet></Results>\n</QIFDocument>')
+        return "\n".join(out) + "\n"
+    q = write("points.qif", qif_points(ev_p))
+    code, out, err = run("evaluate", q, "--format", "qif", "--manifest", PLAN, "--out", f"{W}/qifpts")
+    ev_qp = json.load(open(f"{W}/qifpts/evaluation.json")) if code == 0 else {"cycles": []}
+    bqp = budgets(ev_qp)
+    check("QIF points only: each centre fitted here (25 points), the same errors as the point route (to 1e-9)",
+          code == 0 and sorted(bqp) == sorted(bp) and
+          max(abs(bqp[c][j]["value"] - bp[c][j]["value"]) for c in bp for j in range(7)) <= 1e-9 and
+          all(s["feature"]["centre"].startswith("least-squares sphere of the file's points") and s["feature"]["n_points"] == 25
+              for c in ev_qp["cycles"] for s in c["spheres"]), err)
 
     code, out, err = run("evaluate", q, "--format", "dmis", "--manifest", PLAN, "--out", f"{W}/dmis")
     check("refused: --format dmis for a sphere artifact (a DMIS output is one run), naming what it takes",
