@@ -143,3 +143,37 @@ TEST(FeatureActuals, StatedCentreUncertaintyThroughTheLeastSquares) {
   EXPECT_NEAR(form_ref, 2.0 / 2 / std::sqrt(3.0) / 4, 1e-12);
   EXPECT_EQ(e.cycles[0].spheres[0].stated_u.u_mm.y(), 0.6e-3);
 }
+
+TEST(FeatureActualsFromCmm, ASphereOfPointsOnlyGetsItsLeastSquaresCentreHere) {
+  interop::CmmDocument d;
+  d.file = "points.qif";
+  interop::CmmFeature s;
+  s.name = "S1";
+  s.kind = interop::CmmFeatureKind::Sphere;
+  s.line = 12;
+  const Eigen::Vector3d c(1, -2, 75);
+  // The six poles and two more points of a 12.5 mm sphere about c: its LS centre is c exactly.
+  for (const Eigen::Vector3d& u : {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(-1, 0, 0), Eigen::Vector3d(0, 1, 0),
+                                   Eigen::Vector3d(0, -1, 0), Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0.6, 0, 0.8),
+                                   Eigen::Vector3d(0, 0.8, 0.6)}) {
+    interop::CmmPoint p;
+    p.p_mm = c + 12.5 * u;
+    s.points.push_back(p);
+  }
+  d.features.push_back(s);
+  const auto rows = featureActualsFromCmm(d);
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_TRUE(rows[0].fitted_here);
+  EXPECT_LT((rows[0].location_mm - c).norm(), 1e-9);
+  EXPECT_NEAR(rows[0].size_mm, 25.0, 1e-9);
+  EXPECT_LT(rows[0].form_um, 1e-6);
+  EXPECT_EQ(rows[0].n_points, 7);
+  d.features[0].points.resize(3);
+  try {
+    featureActualsFromCmm(d);
+    ADD_FAILURE() << "3 points accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("points.qif:12: sphere 'S1' has no measured Location and 3 points"), std::string::npos)
+        << e.what();
+  }
+}
