@@ -4,7 +4,8 @@ item 3; docs/thermal-test-piece-evaluation.md §10).
 
 plan the shipped piece (20 min between cycles) on the NMV 5000 -> simulate the test and the CMM
 (its QIF 3.0 Results and DMIS output, features and points) -> evaluate the point route from the
-QIF. Then, from the same CMM run, with the points removed here in Python:
+QIF, and from the same QIF with foreign feature names (points assigned by the nominal geometry:
+the same values). Then, from the same CMM run, with the points removed here in Python:
 - the QIF's MeasuredFeatures only: every value equals the point route's to the file's rounding
   (6 decimals of a mm) and lies within the combined U sqrt(U_points^2 + U_features^2);
 - a feature CSV written from the QIF's features: foreign ids in a shuffled order (matched by the
@@ -125,6 +126,16 @@ try:
     must("evaluate", f"{W}/run/cmm_results.qif", "--manifest", PLAN, "--out", f"{W}/points")
     ev_p = json.load(open(f"{W}/points/evaluation.json"))
     check("the point route evaluates 8 cycles", len(ev_p["cycles"]) == 9 and ev_p["input"]["points"] == 364, ev_p["input"])
+
+    # --- 0. the QIF's points under foreign names: the point route by the nominal geometry ------
+    k = iter(range(1, 1000))
+    foreign = re.sub(r"<FeatureName>[A-Z0-9_]+</FeatureName>", lambda m: f"<FeatureName>FEAT_{next(k):03d}</FeatureName>",
+                     open(f"{W}/run/cmm_results.qif").read())
+    open(f"{W}/foreign_points.qif", "w").write(foreign)
+    code, out, err = run("evaluate", f"{W}/foreign_points.qif", "--manifest", PLAN, "--out", f"{W}/foreign_points")
+    ev_fp = json.load(open(f"{W}/foreign_points/evaluation.json")) if code == 0 else {"cycles": [], "input": {}}
+    check("QIF points under foreign names: assigned by the nominal geometry, the same values as by labels",
+          code == 0 and ev_fp["input"]["assigned_by"] == "nominal geometry" and values(ev_fp) == values(ev_p), err)
 
     # --- 1. the QIF's MeasuredFeatures only ------------------------------------------------------
     qif = strip_qif_points(open(f"{W}/run/cmm_results.qif").read())
