@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "report/report_test_support.hpp"
 #include "model/verdict_strength.hpp"
 
 namespace probeloop::report {
@@ -16,20 +17,15 @@ namespace {
 
 using nlohmann::json;
 namespace fs = std::filesystem;
+using testing::count;
+using testing::dataset;
+using testing::spec;
 
 // A stand-in Vega bundle (one file): these tests check the page the C++ writes; that Vega
 // really draws it is tests/integration/html_render.py's job, in headless Chromium.
-class ModelReport : public ::testing::Test {
+class ModelReport : public testing::PageTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("probeloop-model-report-" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-    vega_ = (dir_ / "vega.min.js").string();
-    std::ofstream(vega_) << "/* stand-in vega */ window.vega = {};\n";
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
-  std::string vega_;
+  ModelReport() : PageTest("model-report") {}
 };
 
 json indicators(double rmse, double smape, double pv, double p99, int n) {
@@ -103,27 +99,7 @@ json diagnosisJson() {
   return d;
 }
 
-std::size_t count(const std::string& hay, const std::string& needle) {
-  std::size_t n = 0;
-  for (std::size_t p = hay.find(needle); p != std::string::npos; p = hay.find(needle, p + needle.size())) ++n;
-  return n;
-}
-
 // The Vega spec of plot k, parsed back from its <script type="application/json">.
-json spec(const std::string& html, int k) {
-  const std::string open = "<script type=\"application/json\" id=\"plot-" + std::to_string(k) + "-spec\">";
-  const std::size_t a = html.find(open);
-  if (a == std::string::npos) return nullptr;
-  const std::size_t b = html.find("</script>", a);
-  return json::parse(html.substr(a + open.size(), b - a - open.size()));
-}
-
-json dataset(const json& spec, const std::string& name) {
-  for (const auto& d : spec["data"])
-    if (d["name"] == name) return d;
-  return nullptr;
-}
-
 TEST_F(ModelReport, OneVegaSpecPerPlotCarryingTheInputValues) {
   const json fit = fitJson(true);
   const std::string html = modelReportHtml(fit, nullptr, vega_);

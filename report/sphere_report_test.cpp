@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "report/report_test_support.hpp"
 #include "report/sphere_report_plots.hpp"
 
 namespace probeloop::report {
@@ -17,22 +18,17 @@ namespace {
 
 using nlohmann::json;
 namespace fs = std::filesystem;
+using testing::count;
+using testing::dataset;
+using testing::spec;
 
 // Hand-made evaluations in the schema of `probeloop evaluate` for a sphere artifact
 // (docs/formats.md#evaluation-json): six cycles 420 s apart, cycle 1 the reference. A stand-in
 // Vega bundle: these tests check the page the C++ writes; tests/integration/
 // sphere_report_check.py renders it in Chromium.
-class SphereReport : public ::testing::Test {
+class SphereReport : public testing::PageTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("probeloop-sphere-report-" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-    vega_ = (dir_ / "vega.min.js").string();
-    std::ofstream(vega_) << "/* stand-in vega */ window.vega = {};\n";
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
-  std::string vega_;
+  SphereReport() : PageTest("sphere-report") {}
 };
 
 constexpr int kCycles = 6;
@@ -139,20 +135,6 @@ std::string inputsCsv() {
   return s;
 }
 
-std::size_t count(const std::string& hay, const std::string& needle) {
-  std::size_t n = 0;
-  for (std::size_t p = hay.find(needle); p != std::string::npos; p = hay.find(needle, p + needle.size())) ++n;
-  return n;
-}
-
-json spec(const std::string& html, int k) {
-  const std::string open = "<script type=\"application/json\" id=\"plot-" + std::to_string(k) + "-spec\">";
-  const std::size_t a = html.find(open);
-  if (a == std::string::npos) return nullptr;
-  const std::size_t b = html.find("</script>", a);
-  return json::parse(html.substr(a + open.size(), b - a - open.size()));
-}
-
 std::vector<json> specs(const std::string& html) {
   std::vector<json> out;
   for (int k = 1;; ++k) {
@@ -160,12 +142,6 @@ std::vector<json> specs(const std::string& html) {
     if (s.is_null()) return out;
     out.push_back(std::move(s));
   }
-}
-
-json dataset(const json& s, const std::string& name) {
-  for (const auto& d : s["data"])
-    if (d["name"] == name) return d;
-  return nullptr;
 }
 
 json mark(const json& s, const std::string& name) {

@@ -10,27 +10,23 @@
 #include <string>
 
 #include "core/error.hpp"
+#include "report/report_test_support.hpp"
 
 namespace probeloop::report {
 namespace {
 
 using nlohmann::json;
 namespace fs = std::filesystem;
+using testing::count;
+using testing::dataset;
+using testing::spec;
 
 // Hand-made evaluations in the schema of `probeloop evaluate` for a stepped workpiece (W8,
 // four steps). A stand-in Vega bundle: these tests check the page the C++ writes;
 // tests/integration/sw_separation.py renders it in Chromium.
-class SwReport : public ::testing::Test {
+class SwReport : public testing::PageTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("probeloop-sw-report-" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-    vega_ = (dir_ / "vega.min.js").string();
-    std::ofstream(vega_) << "/* stand-in vega */ window.vega = {};\n";
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
-  std::string vega_;
+  SwReport() : PageTest("sw-report") {}
 };
 
 json budget(double value, double u_c) {
@@ -103,26 +99,6 @@ json evaluation(double shift = 0.0, bool with_before_after = false) {
     e["before_after"] = ba;
   }
   return e;
-}
-
-std::size_t count(const std::string& hay, const std::string& needle) {
-  std::size_t n = 0;
-  for (std::size_t p = hay.find(needle); p != std::string::npos; p = hay.find(needle, p + needle.size())) ++n;
-  return n;
-}
-
-json spec(const std::string& html, int k) {
-  const std::string open = "<script type=\"application/json\" id=\"plot-" + std::to_string(k) + "-spec\">";
-  const std::size_t a = html.find(open);
-  if (a == std::string::npos) return nullptr;
-  const std::size_t b = html.find("</script>", a);
-  return json::parse(html.substr(a + open.size(), b - a - open.size()));
-}
-
-json dataset(const json& s, const std::string& name) {
-  for (const auto& d : s["data"])
-    if (d["name"] == name) return d;
-  return nullptr;
 }
 
 std::string between(const std::string& html, const std::string& from, const std::string& to) {

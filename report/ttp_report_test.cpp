@@ -12,27 +12,23 @@
 #include <vector>
 
 #include "core/error.hpp"
+#include "report/report_test_support.hpp"
 
 namespace probeloop::report {
 namespace {
 
 using nlohmann::json;
 namespace fs = std::filesystem;
+using testing::count;
+using testing::dataset;
+using testing::spec;
 
 // Hand-made evaluations in the schema of `probeloop evaluate` for a thermal test piece: the
 // reference cut at t = 1200 s, one cycle per hour after it. A stand-in Vega bundle: these
 // tests check the page the C++ writes; tests/integration/ttp_report_check.py renders it.
-class TtpReport : public ::testing::Test {
+class TtpReport : public testing::PageTest {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("probeloop-ttp-report-" + std::to_string(::getpid()));
-    fs::create_directories(dir_);
-    vega_ = (dir_ / "vega.min.js").string();
-    std::ofstream(vega_) << "/* stand-in vega */ window.vega = {};\n";
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  fs::path dir_;
-  std::string vega_;
+  TtpReport() : PageTest("ttp-report") {}
 };
 
 constexpr double kT0 = 1200.0;
@@ -113,26 +109,6 @@ std::string rTestCsv(double first_s = kT0) {
     s += row;
   }
   return s;
-}
-
-std::size_t count(const std::string& hay, const std::string& needle) {
-  std::size_t n = 0;
-  for (std::size_t p = hay.find(needle); p != std::string::npos; p = hay.find(needle, p + needle.size())) ++n;
-  return n;
-}
-
-json spec(const std::string& html, int k) {
-  const std::string open = "<script type=\"application/json\" id=\"plot-" + std::to_string(k) + "-spec\">";
-  const std::size_t a = html.find(open);
-  if (a == std::string::npos) return nullptr;
-  const std::size_t b = html.find("</script>", a);
-  return json::parse(html.substr(a + open.size(), b - a - open.size()));
-}
-
-json dataset(const json& s, const std::string& name) {
-  for (const auto& d : s["data"])
-    if (d["name"] == name) return d;
-  return nullptr;
 }
 
 std::vector<std::string> plotQuantities(const std::string& html) {
