@@ -59,7 +59,7 @@ std::vector<FeatureActual> parseFeatureActuals(const std::string& text, const st
   const int n_u = (cu[0] >= 0) + (cu[1] >= 0) + (cu[2] >= 0);
   if (n_u != 0 && n_u != 3)
     throw InputError(file, t.header_line, "the stated uncertainty needs all three columns u_x_um,u_y_um,u_z_um or none");
-  const int c_time = t.column("time_s");
+  const int c_time = t.column("time_s"), c_alg = t.column("algorithm");
   std::vector<FeatureActual> out;
   for (const auto& row : t.rows) {
     FeatureActual f;
@@ -109,6 +109,7 @@ std::vector<FeatureActual> parseFeatureActuals(const std::string& text, const st
       f.u_um = u;
     }
     if (!blank(row, c_time)) f.time_s = t.number(row, c_time);
+    if (!blank(row, c_alg)) f.algorithm = row.fields[static_cast<std::size_t>(c_alg)];
     checkPlausible(f);
     out.push_back(std::move(f));
   }
@@ -159,6 +160,7 @@ std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, 
     f.direction = c.measured.direction;
     f.size_mm = c.measured.diameter_mm;
     f.form_um = c.measured.form_mm * 1e3;
+    f.algorithm = c.measured.algorithm;
     f.n_points = static_cast<int>(std::min<std::size_t>(c.points.size(), 1000000000));
     if (f.has_geometry) checkPlausible(f);
     out.push_back(std::move(f));

@@ -4,7 +4,8 @@
 //
 // CSV columns `cycle,id,kind,x_mm,y_mm,z_mm,i,j,k,size_mm,form_um,n_points`, optional
 // `u_x_um,u_y_um,u_z_um` (all three columns or none; per row all three fields or none: the
-// stated standard uncertainty of the location) and `time_s` (empty: not given); the separators and decimal marks of core/csv.hpp. kind is sphere, circle,
+// stated standard uncertainty of the location), `time_s` (empty: not given) and `algorithm`
+// (the fitting criterion, QIF's names: LEASTSQUARES, MINMAX, ...; empty: not stated); the separators and decimal marks of core/csv.hpp. kind is sphere, circle,
 // cylinder, plane or point; x/y/z the centre (sphere, circle), a point on the axis (cylinder)
 // or on the plane; i/j/k the axis or normal (empty or 0 for a sphere or point); size_mm the
 // diameter (empty for a plane or point); form_um the form deviation (empty: not stated);
@@ -41,6 +42,9 @@ struct FeatureActual {
   std::optional<double> time_s;
   bool has_geometry = true;  // false: a QIF/DMIS feature with points but no measured geometry
   bool fitted_here = false;  // a sphere of points only: its centre fitted here (featureActualsFromCmm)
+  // How the CMM fitted it, as the file states it (QIF SubstituteFeatureAlgorithmEnum names,
+  // e.g. LEASTSQUARES, MINMAX; the CSV's optional column `algorithm`); "" not stated.
+  std::string algorithm;
 };
 
 // max_cycle > 0 refuses a cycle beyond it (the plan's cycles).

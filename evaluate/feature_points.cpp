@@ -1,5 +1,6 @@
 #include "evaluate/feature_points.hpp"
 
+#include <cctype>
 #include <cmath>
 
 #include "core/csv.hpp"
@@ -36,6 +37,34 @@ double expectedRangeOfNormals(int n) {
 double sigmaFromForm(double form_mm, int n, int p) {
   if (!std::isfinite(form_mm) || n <= p || n < 2) return NAN;
   return form_mm / (expectedRangeOfNormals(n) * std::sqrt(static_cast<double>(n - p) / n));
+}
+
+bool isLeastSquares(const std::string& algorithm) {
+  std::string s;
+  for (const unsigned char c : algorithm)
+    if (!std::isspace(c) && c != '_' && c != '-') s += static_cast<char>(std::toupper(c));
+  return s == "LEASTSQUARES" || s == "LSQ" || s == "LS";
+}
+
+std::string fittingCriterionNote(const FeatureMatch& match) {
+  int ls = 0, none = 0;
+  std::string others;
+  for (const auto& m : match.matched) {
+    const auto& a = m.actual.algorithm;
+    if (a.empty()) ++none;
+    else if (isLeastSquares(a)) ++ls;
+    else others += (others.empty() ? "" : ", ") + m.feature->nominal.id + " (" + a + ")";
+  }
+  const int n = static_cast<int>(match.matched.size());
+  if (none == n)
+    return "The file does not say how its features were fitted: taken as least squares, the point route's criterion (a "
+           "minimum-zone or Chebyshev feature differs from it by a fraction of its form).";
+  std::string o = "The file states the fitting criterion of " + std::to_string(n - none) + " of its " + std::to_string(n) +
+                  " features: least squares for " + std::to_string(ls) + " (the point route's criterion)";
+  if (!others.empty())
+    o += "; another for " + others + ": their values differ from least squares' by a fraction of their form and are taken as stated";
+  if (none) o += "; " + std::to_string(none) + " state none, taken as least squares";
+  return o + ".";
 }
 
 PointsOnStatedFeatures pointsOnStatedFeatures(const FeatureMatch& match,

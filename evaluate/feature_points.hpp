@@ -54,6 +54,14 @@ PointsOnStatedFeatures pointsOnStatedFeatures(const FeatureMatch& match,
                                               const std::map<std::string, std::vector<Eigen::Vector3d>>& planned,
                                               const std::string& file, const std::string& format);
 
+// What the file says about how its features were fitted, as one sentence for the notes: all
+// stated least squares (the point route's criterion), some another criterion (named, with their
+// ids: their values differ from least squares' by a fraction of their form, taken as stated),
+// none stated (taken as least squares). A name counts as least squares when, case, spaces, '_'
+// and '-' ignored, it is LEASTSQUARES, LSQ or LS.
+std::string fittingCriterionNote(const FeatureMatch& match);
+bool isLeastSquares(const std::string& algorithm);
+
 // d2(n): the expected range of n independent standard normal deviates (n >= 2), by numerical
 // integration of E[R] = int (1 - Phi(x)^n - (1 - Phi(x))^n) dx (ISO 8258 / ASTM E2587 tabulate
 // it: d2(2) = 1.128, d2(5) = 2.326, d2(10) = 3.078).

@@ -64,6 +64,7 @@ SwStatedCmm swCmmFromFeatures(const parts::PlanManifest& m, const std::vector<Fe
   out.from.format = format;
   out.from.assigned_by = match.assigned_by;
   out.from.other_kinds = match.other_kinds;
+  out.criterion_note = fittingCriterionNote(match);
   for (const auto& u : match.unmatched) out.from.unmatched.push_back(unmatchedText(u));
   for (const auto& f : m.features)
     if (f.nominal.kind == "plane" && !match.find(f.nominal.id))
@@ -119,8 +120,8 @@ SwEvaluation evaluateSteppedWorkpieceFromFeatures(const parts::PlanManifest& m, 
   e.notes.push_back("CMM side from the stated features of " + file + " (" + format + ", no points; matched by " + cmm.from.assigned_by +
                     "): the plan's CMM points placed on each stated plane, so the widths, depths, tilts, slopes and Oz are the "
                     "file's planes evaluated as the point route evaluates its own fits");
-  e.notes.push_back("lost against the point route: the CMM's fitting criterion (taken as least squares; a minimum-zone or "
-                    "Chebyshev plane differs by a fraction of its form), the real point layout and residuals (each plane's "
+  e.notes.push_back(cmm.criterion_note);
+  e.notes.push_back("lost against the point route: the real point layout and residuals (each plane's "
                     "per-point sigma is the largest of what is stated: form over d2(n) for " + std::to_string(form) +
                     " planes, the MPE for " + std::to_string(mpe) + ", a stated u for " + std::to_string(stated) +
                     "; the slopes' u from the planned layout), outliers (the file's planes are taken as they are), and the "

@@ -46,6 +46,7 @@ PlannedCmmPoints swPlannedCmmPoints(const parts::PlanManifest& m);
 struct SwStatedCmm {
   SwSourceGeometry geometry;  // route "cmm"
   SwFromFeatures from;
+  std::string criterion_note;  // what the file says of its fitting criterion (fittingCriterionNote)
 };
 SwStatedCmm swCmmFromFeatures(const parts::PlanManifest& m, const std::vector<FeatureActual>& rows,
                               const PlannedCmmPoints& planned, const std::string& file, const std::string& format);

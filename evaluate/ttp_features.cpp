@@ -125,8 +125,7 @@ TtpEvaluation evaluateThermalTestPieceFromFeatures(const parts::PlanManifest& m,
   e.notes.push_back("Evaluated from the " + std::to_string(st.features.size()) + " features the file states, without points: the plan's " +
                     std::to_string(e.points) + " points placed on them (a least-squares fit of them returns each stated feature), "
                     "so every value is the point route's from the same least-squares features.");
-  e.notes.push_back("The file does not say how its features were fitted: taken as least squares (a minimum-zone or Chebyshev "
-                    "feature differs from it by a fraction of its form).");
+  e.notes.push_back(fittingCriterionNote(match));
   e.notes.push_back("Lost against the point route: the type A scatter of the residuals (each feature's scatter is estimated from "
                     "its stated form over d2(n) instead, or the specification where larger), the real point layout (the plan's "
                     "gives the sensitivities), the outlier check, the minimum-zone form (the stated form is reported as it is), "

@@ -32,6 +32,9 @@ struct CmmGeometry {
   Eigen::Vector3d direction = Eigen::Vector3d::Zero();
   double diameter_mm = NAN;  // sphere, cylinder, circle
   double form_mm = NAN;      // measured form, when known
+  // The fitting algorithm the file states for it (QIF SubstituteFeatureAlgorithmEnum, e.g.
+  // LEASTSQUARES, MINMAX; "OTHER: <text>" for OtherSubstituteFeatureAlgorithm); "" not stated.
+  std::string algorithm;
 };
 
 struct CmmFeature {

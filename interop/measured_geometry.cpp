@@ -39,6 +39,7 @@ bool fitMeasuredGeometry(CmmFeature& f) {
     if (f.nominal.direction.norm() > 0 && g.direction.dot(f.nominal.direction) < 0) g.direction = -g.direction;
     g.diameter_mm = kind == geometry::ElementKind::Plane ? NAN : 2 * fit.element.radius_mm;
     g.form_mm = fit.form_mm;
+    g.algorithm = "LEASTSQUARES";
     return true;
   } catch (const GeometryError&) {
     return false;

@@ -322,6 +322,8 @@ std::string qifResults(const CmmDocument& results) {
     if (!f.points.empty()) w.add(w.list(e, "PointList", 1), "WholePointSetId", std::to_string(set_id[i]));
     const auto& g = f.measured;
     if (!g.given) continue;
+    if (!g.algorithm.empty() && g.algorithm.rfind("OTHER: ", 0) != 0)
+      w.add(w.add(e, "SubstituteFeatureAlgorithm"), "SubstituteFeatureAlgorithmEnum", g.algorithm);
     if (f.kind == CmmFeatureKind::Cylinder) {
       auto* ax = w.add(e, "Axis");
       w.add(ax, "AxisPoint", point(g.location_mm));

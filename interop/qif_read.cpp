@@ -81,7 +81,7 @@ const std::map<std::string, int> kResultsOrder{
 const std::map<std::string, int> kMeasurementOrder{
     {"Attributes", 0}, {"FeatureItemId", 1}, {"FeatureName", 2},  {"TimeStamp", 3},  {"ActualComponentId", 4},
     {"ManufacturingProcessId", 5}, {"MeasurementDeviceIds", 6}, {"ActualTransformId", 7}, {"NotedEventIds", 8},
-    {"PointList", 9},  {"Location", 10},     {"Axis", 10},        {"Normal", 10},    {"Direction", 10},
+    {"PointList", 9},  {"SubstituteFeatureAlgorithm", 9}, {"Location", 10},     {"Axis", 10},        {"Normal", 10},    {"Direction", 10},
     {"Diameter", 10},  {"Form", 10}};
 
 // Element order: the XSD fixes it, the meaning does not depend on it (elements are found by name).

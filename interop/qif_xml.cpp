@@ -64,6 +64,10 @@ CmmGeometry geometryOf(const Reader& r, const xmlNode* e, CmmFeatureKind kind) {
   }
   if (const auto* dia = child(e, "Diameter")) g.diameter_mm = r.lengthOf(dia);
   if (const auto* form = child(e, "Form")) g.form_mm = r.lengthOf(form);
+  if (const auto* alg = child(e, "SubstituteFeatureAlgorithm")) {
+    if (const auto* en = child(alg, "SubstituteFeatureAlgorithmEnum")) g.algorithm = text(en);
+    else if (const auto* other = child(alg, "OtherSubstituteFeatureAlgorithm")) g.algorithm = "OTHER: " + text(other);
+  }
   return g;
 }
 

@@ -129,10 +129,12 @@ try:
               for p in ff["planes"]), ff)
     notes = " ".join(ev_a["notes"])
     report = open(f"{W}/qif/report.md").read() if code == 0 else ""
-    lost = "lost against the point route: the CMM's fitting criterion (taken as least squares"
-    check("(a) what is lost, in the notes and report.md (criterion, layout and residuals, outliers, the lines)",
+    lost = "lost against the point route: the real point layout and residuals"
+    criterion = "The file states the fitting criterion of 21 of its 21 features: least squares for 21"
+    check("(a) what is lost, in the notes and report.md (layout and residuals, outliers, the lines), and the criterion "
+          "the QIF states (SubstituteFeatureAlgorithm)",
           lost in notes and lost in report and "outliers" in notes and "line of each point" in notes and
-          "## CMM planes from the stated features" in report, notes)
+          criterion in notes and "## CMM planes from the stated features" in report, notes)
     e_pos = ev_a["separation"][0]["e_pos_x_um"]["contributions"]
     check("(a) the e_pos budget's CMM term says it comes from the stated features",
           any(c["input"] == "CMM planes as stated" and c["basis"].startswith("from the stated features") for c in e_pos),

@@ -157,6 +157,9 @@ try:
           inputs["point scatter (type A), this and the reference cycle"]["u"] == 0, list(inputs))
     report = open(f"{W}/qif/report.md").read()
     check("report.md lists the stated features", "## Stated features" in report and "| TOP | TOP |" in report)
+    check("the QIF states least squares for every feature (SubstituteFeatureAlgorithm), and the notes say so",
+          any("The file states the fitting criterion of 49 of its 49 features: least squares for 49" in n for n in st["notes"]),
+          st["notes"])
 
     # --- 2. a feature CSV: foreign ids, shuffled, counts stated, extra rows ----------------------
     counts = {}
@@ -164,11 +167,14 @@ try:
         counts[p["feature"]] = counts.get(p["feature"], 0) + 1
     feats = qif_features(qif)
     random.Random(7).shuffle(feats)
-    rows = [HEADER, "1,REF_SPHERE,sphere,300,0,50,,,,25.4,0.3,25", "1,PT_7,point,1,2,3,,,,,,1"]
+    # The fitting criterion stated per row (column algorithm): least squares, one facet Chebyshev.
+    rows = [HEADER + ",algorithm", "1,REF_SPHERE,sphere,300,0,50,,,,25.4,0.3,25,", "1,PT_7,point,1,2,3,,,,,,1,"]
+    chebyshev = sorted(name for name, *_ in feats if name.startswith("X1_"))[0]
     for k, (name, kind, loc, d, size, form) in enumerate(feats):
         kind = "circle" if kind == "cylinder" else kind  # a CMM reports the one-level band as a circle
         rows.append(f"1,{kind.upper()}_{k + 1},{kind},{loc[0]!r},{loc[1]!r},{loc[2]!r},{d[0]!r},{d[1]!r},{d[2]!r},"
-                    f"{size!r},{form * 1e3!r},{counts[name]}".replace(",'',", ",,"))
+                    f"{size!r},{form * 1e3!r},{counts[name]},{'MINMAX' if name == chebyshev else 'least_squares'}"
+                    .replace(",'',", ",,"))
     open(f"{W}/features.csv", "w").write("\n".join(rows) + "\n")
     code, out, err = run("evaluate", f"{W}/features.csv", "--manifest", PLAN, "--out", f"{W}/csv")
     check("evaluate: a feature CSV (auto-detected), foreign ids by the nominal geometry",
@@ -181,6 +187,9 @@ try:
           f"{W}/features.csv:2" in st["unmatched"][0] and st["rows_of_other_kinds_not_used"] == 1, st["unmatched"])
     check("each feature names its row and the counts the file states",
           all(f["matched_by"] == "nominal geometry" and f["n_points_stated"] == counts[f["id"]] for f in st["features"]))
+    check("the criterion the rows state: 48 least squares, the one Chebyshev facet named",
+          any(f"least squares for 48 (the point route's criterion); another for {chebyshev} (MINMAX)" in n for n in st["notes"]),
+          st["notes"])
 
     # --- 3. the DMIS output's FA actuals, no points ------------------------------------------------
     dmo = strip_dmis_points(open(f"{W}/run/cmm_results.dmo").read())
@@ -192,6 +201,8 @@ try:
           code == 0 and "the features a CMM states (dmis)" in out, out + err)
     ev_d = json.load(open(f"{W}/dmis/evaluation.json"))
     compare("DMIS FA actuals", ev_p, ev_d, exact=0.002)
+    check("DMIS FA states no criterion: taken as least squares, said so",
+          any(n.startswith("The file does not say how its features were fitted") for n in ev_d["stated_features"]["notes"]))
     check("no form in DMIS FA: every feature's scatter is the specification",
           all(f["point_sigma_from"] == "specification" and f["form_um"] is None for f in ev_d["stated_features"]["features"]))
 
