@@ -103,6 +103,19 @@ if code == 0:
               c4 == 0 and any(l.startswith(f"warning: {W}/vendor.qif:{ext_line}: MeasurementResults: unknown extension Probe")
                               for l in out4.split("\n"))
               and numbers(f"{T}/ev-vendor/errors.csv") == a, out4[-600:] + e4)
+        # ... and in every output that used the file (issue 34 item 4); the clean file's have none.
+        if c4 == 0:
+            ev4, ev2 = json.load(open(f"{T}/ev-vendor/evaluation.json")), json.load(open(f"{T}/ev-qif/evaluation.json"))
+            iw = ev4.pop("input_warnings", [])
+            check("evaluation.json: input_warnings [{file, line, what}] with the extension's line; nothing else changed "
+                  "(the file's name aside); none in the clean file's",
+                  [(w["file"], w["line"]) for w in iw] == [(f"{W}/vendor.qif", ext_line)]
+                  and iw[0]["what"].startswith("MeasurementResults: unknown extension Probe") and "input_warnings" not in ev2
+                  and json.dumps(ev4).replace(f"{W}/vendor.qif", f"{T}/run/cmm_results.qif") == json.dumps(ev2), iw)
+            r4, r2 = open(f"{T}/ev-vendor/report.md").read(), open(f"{T}/ev-qif/report.md").read()
+            check("report.md: the 'Input warnings' section with the file and line; none in the clean file's",
+                  f"## Input warnings" in r4 and f"- `{W}/vendor.qif` line {ext_line}: MeasurementResults: unknown extension Probe" in r4
+                  and "Input warnings" not in r2, r4[-400:])
         c5, _, e5 = run("evaluate", f"{W}/vendor.qif", "--manifest", f"{T}/plan/plan.json", "--out", f"{T}/ev-strict", "--strict")
         check("evaluate --strict: refused at that line, nothing written", c5 != 0 and f"vendor.qif:{ext_line}: MeasurementResults: unknown "
               "extension Probe" in e5 and not os.path.exists(f"{T}/ev-strict/errors.csv"), e5)
@@ -223,6 +236,25 @@ if code == 0:
         c3, _, e3 = run("evaluate", f"{S}/run-dmis/cmm_results.dmo", *args, "--out", f"{S}/ev-dmis") if code == 0 else (1, "", err)
         check("W8: the CMM runs cmm_plan.dmi (moves checked) and its DMIS output gives the CSV route's errors.csv",
               c3 == 0 and numbers(f"{S}/ev-dmis/errors.csv") == a, e3)
+        if c3 == 0:
+            # A statement after ENDFIL (issue 34): passed over with a warning in stdout, evaluation.json
+            # and report.md; the same errors.csv; --strict refuses it.
+            dmo = open(f"{S}/run-dmis/cmm_results.dmo").read()
+            late = dmo.count("\n") + 1
+            open(f"{W}/late.dmo", "w").write(dmo + "DISPLY/OFF\n")
+            c6, out6, e6 = run("evaluate", f"{W}/late.dmo", *args, "--out", f"{S}/ev-late")
+            ev6 = json.load(open(f"{S}/ev-late/evaluation.json")) if c6 == 0 else {}
+            r6 = open(f"{S}/ev-late/report.md").read() if c6 == 0 else ""
+            what = "statements after ENDFIL; passed over"
+            check(f"W8: a statement after ENDFIL warned at line {late} in stdout, evaluation.json and report.md; the same errors.csv",
+                  c6 == 0 and f"warning: {W}/late.dmo:{late}: {what}" in out6 and numbers(f"{S}/ev-late/errors.csv") == a
+                  and ev6.get("input_warnings") == [{"file": f"{W}/late.dmo", "line": late, "what": what}]
+                  and f"- `{W}/late.dmo` line {late}: {what}" in r6
+                  and "input_warnings" not in json.load(open(f"{S}/ev-dmis/evaluation.json"))
+                  and "Input warnings" not in open(f"{S}/ev-dmis/report.md").read(), (out6[-300:], e6, ev6.get("input_warnings")))
+            c7, _, e7 = run("evaluate", f"{W}/late.dmo", *args, "--out", f"{S}/ev-late-strict", "--strict")
+            check("W8 --strict: refused at that line, nothing written",
+                  c7 != 0 and f"late.dmo:{late}: statements after ENDFIL" in e7 and not os.path.exists(f"{S}/ev-late-strict/errors.csv"), e7)
         ok, e = valid(f"{S}/ev-qif/results.qif")
         check("W8's results.qif (e_pos, e_proc, e_splz per step with u) validates against the QIF 3.0 XSD", ok, e)
         code, out, err = run("read", f"{S}/ev-qif/results.qif", "--json")
