@@ -13,6 +13,9 @@
 - DMIS: the plans' cmm_plan.dmi (every PTMEAS of cmm_points.csv, lines within 80 characters)
   drives the simulated CMM, which checks every move against the part as cut and answers with
   cmm_results.dmo; evaluate on it gives the CSV route's errors.csv, every printed digit;
+- the reader's warnings (issue 34 item 4): a vendor extension in the thermal test piece's QIF and
+  a statement after ENDFIL in W8's DMIS output reach stdout, evaluation.json's input_warnings
+  and report.md's section (none in the clean files'), the same errors.csv; --strict refuses them;
 - bad input: a QIF file of another version, a point set whose count does not match its points,
   a DMIS output with a feature we did not plan, and a DMIS program whose move goes through the
   part are refused naming the file, the line and the field, and nothing is written.
