@@ -191,6 +191,18 @@ if code == 0:
                        "--out", f"{W}/bad-crash", cwd=f"{T}/plan")
     check(f"a DMIS program that moves through the part is refused at its line {first_clear + 2}, nothing written",
           code != 0 and f"crash.dmi:{first_clear + 2}: GOTO to " in err and "the move enters the part at" in err and not os.path.exists(f"{W}/bad-crash"), err)
+    # A program drives the CMM: read strictly by simulate (what read would warn about is refused),
+    # leniently by read.
+    open(f"{T}/plan/late.dmi", "w").write(dmi + "GOTO/0,0,-50\n")
+    code, _, err = run("simulate", "pre_machining.nc", "--machine", f"{SRC}/parts/machines/nmv5000.yaml",
+                       "--part", piece, "--truth", f"{SRC}/examples/truth_thermal_test.yaml", "--cmm-points", "late.dmi",
+                       "--out", f"{W}/bad-late", cwd=f"{T}/plan")
+    check(f"simulate: a program with a move after ENDFIL is refused at its line {len(lines) + 1}, nothing written",
+          code != 0 and f"late.dmi:{len(lines) + 1}: statements after ENDFIL" in err and not os.path.exists(f"{W}/bad-late"), err)
+    code, out, err = run("read", f"{T}/plan/late.dmi", "--json")
+    check("read: the same program read, with the warning at that line",
+          code == 0 and [(w["line"], w["what"]) for w in json.loads(out)["warnings"]] == [(len(lines) + 1, "statements after ENDFIL; passed over")],
+          out[-300:] + err)
     code, out, err = run("read", f"{T}/run/cmm_results.qif", "--json")
     d = json.loads(out) if code == 0 else {}
     cyl = [f for f in d.get("features", []) if f["name"] == "CYL"]
