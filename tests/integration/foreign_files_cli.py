@@ -281,5 +281,8 @@ print(f"DMIS bore: fit r = {param(j, 'r_mm')} mm, independent LS r = {r_b:.7f} m
 check(f"fit cylinder --feature CYL on the DMIS output: r = independent LS {r_b:.7f} mm within 1e-6 mm, axis within 1e-6 rad, "
       "the two warnings carried",
       rc == 0 and abs(param(j, "r_mm") - r_b) < 1e-6 and angle(axis_of(j), d_b) < 1e-6 and len(j.get("warnings", [])) >= 2, (j.get("parameters"), err))
+rc, js2, err = run("fit", "cylinder", DMO, "--feature", "cyl", "--json")
+check("fit --feature cyl: DMIS labels are case-insensitive (the same cylinder)",
+      rc == 0 and param(json.loads(js2), "r_mm") == param(j, "r_mm"), err)
 os.remove(DMO)
 check.finish()
