@@ -15,6 +15,9 @@ of tests/data/foreign (README.md there has each file's provenance):
   CheckMate's direction within 0.1 mrad; the warnings reach fit's output (text and --json).
 - the DMSC's demoQIFout.py results (features only): read with its four features and their
   diameters (from the file's text), no points, no warning; `fit` refuses it for want of points.
+- the CheckMate file as KBO Systems' QIF_Import writes it back: CheckMate's 691 points set by
+  set, the same two warnings at its own lines, the 12 characteristic values it lost named in a
+  note, and CYL_1's cylinder as from the original;
 - the DMSC's Exploded_Results1.QIF (characteristics only, items in another document): no
   features, the two values of its text, no warning, the missing FileUnits in a note;
 - Mitutoyo's QIF 2.0.0 results sample: refused at its root's line, naming the namespace;
@@ -207,6 +210,42 @@ check(f"testPython30: {len(meas)} measured features ({', '.join(meas)}; diameter
       and all(not f["points_mm"] for f in d["features"]) and d["warnings"] == [] and "point_sets" not in d, (got, err))
 rc, out, err = run("fit", "cylinder", PY, "--feature", "DAT_B")
 check("testPython30: fit refuses a file without points", rc != 0 and f"no measured features with points in the file ({len(meas)} features)" in err, err)
+
+# The same CheckMate file as KBO Systems' QIF_Import (a .NET QIF library) writes it back: another
+# producer's serialization (attributes reordered, points tab-indented, E-notation), its mistakes
+# kept, and 12 characteristic values lost (measurements with a status only).
+KB = os.path.join(SRC, "tests", "data", "foreign", "qif", "kbo", "QIF_PTS_SAMPLE.conv.qif")
+kb = open(KB, encoding="utf-8").read()
+kb_lines = kb.split("\n")
+kb_sets = {}
+for m in re.finditer(r"<MeasuredPointSet ([^>]*)>(.*?)</MeasuredPointSet>", kb, re.S):
+    sid = re.search(r'id="(\d+)"', m.group(1)).group(1)
+    nums = [float(x) for x in re.search(r"<Points>(.*?)</Points>", m.group(2), re.S).group(1).split()]
+    kb_sets[sid] = [nums[i:i + 3] for i in range(0, len(nums), 3)]
+check("KBO: the 12 point sets hold CheckMate's 691 points, set by set, every digit (both texts parsed here)",
+      kb_sets == points_by_set, sorted(kb_sets))
+kb_self = next(i + 1 for i, l in enumerate(kb_lines) if "<WholePointSetId>828</WholePointSetId>" in l)
+kb_nolist = next(i + 1 for i, l in enumerate(kb_lines) if '<PointFeatureMeasurement id="776">' in l)
+no_value = [b for b in re.findall(r"<(\w+CharacteristicMeasurement) id=\"\d+\">(.*?)</\1>", kb, re.S) if "<Value>" not in b[1]]
+rc, js, err = run("read", KB, "--json")
+d = json.loads(js) if rc == 0 else {}
+ws = sorted((w["line"], w["what"].split(";")[0]) for w in d.get("warnings", []))
+check(f"KBO: read gives 14 features, 12 sets with 691 points ({assigned} assigned), the two mistakes warned at its own lines "
+      f"{kb_nolist} and {kb_self}",
+      rc == 0 and len(d["features"]) == 14 and d["point_sets"] == {"count": 12, "points": 691}
+      and sum(len(f["points_mm"]) for f in d["features"]) == assigned
+      and [x[0] for x in ws] == sorted([kb_self, kb_nolist]), (ws, err))
+check(f"KBO: the {len(no_value)} characteristic measurements without a Value named in a note, the others read "
+      f"({len(re.findall('<Value>', kb.split('<MeasuredCharacteristics>')[1]))})",
+      rc == 0 and len(no_value) == 12 and any(n.startswith("12 characteristic measurements without a Value") for n in d["notes"])
+      and len(d["characteristics"]) == len(re.findall("<Value>", kb.split("<MeasuredCharacteristics>")[1])), (d.get("notes"), err))
+rc, _, err = run("read", KB, "--strict")
+check(f"KBO --strict: refused at line {min(kb_self, kb_nolist)}", rc != 0 and f"{KB}:{min(kb_self, kb_nolist)}: " in err, err)
+rc, js, err = run("fit", "cylinder", KB, "--feature", "CYL_1", "--json")
+j = json.loads(js) if rc == 0 else {}
+print(f"KBO fit cylinder CYL_1: r = {param(j, 'r_mm')} mm, form {j.get('form_um')} um")
+check(f"KBO: fit cylinder --feature CYL_1 = the independent LS cylinder of CheckMate's points ({r_ls:.6f} mm) within 1e-6 mm",
+      rc == 0 and abs(param(j, "r_mm") - r_ls) < 1e-6 and angle(axis_of(j), d_ls) < 1e-6, err)
 
 # The DMSC's Exploded_Results1.QIF: characteristic measurements only, referring to their items in
 # another document (xId), no features, no FileUnits.
