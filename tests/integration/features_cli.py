@@ -185,6 +185,13 @@ try:
     check("report.md: an 'Input warnings' section naming the file and line; the clean file's report has none",
           f"## Input warnings" in rep_v and f"- `{v}` line {ext_line}: {what}" in rep_v and "Input warnings" not in rep_q
           and "input_warnings" not in ev_q, rep_v[-500:])
+    # ... and the HTML page made from that evaluation.json (probeloop report sphere).
+    c1, _, e1 = run("report", "sphere", "--evaluation", f"{W}/vendor/evaluation.json", "--html", f"{W}/vendor.html")
+    c2, _, e2 = run("report", "sphere", "--evaluation", f"{W}/qif/evaluation.json", "--html", f"{W}/clean.html")
+    page_v = open(f"{W}/vendor.html").read() if c1 == 0 else ""
+    page_q = open(f"{W}/clean.html").read() if c2 == 0 else ""
+    check("report sphere: the page from the warned evaluation has the 'Input warnings' section with the line; the clean one none",
+          f"<h2>Input warnings</h2>" in page_v and f"line {ext_line}: {what}" in page_v and "Input warnings" not in page_q, e1 + e2)
     code, out, err = run("evaluate", v, "--format", "qif", "--manifest", PLAN, "--out", f"{W}/vendor-strict", "--strict")
     check("--strict: refused at that line, nothing written", code != 0 and f"{v}:{ext_line}: {what}" in err
           and not os.path.exists(f"{W}/vendor-strict/evaluation.json"), err)
