@@ -76,7 +76,7 @@ Subcommand addEvaluateCommand(CLI::App& app) {
   ev->add_option("--format", a->format, "auto, linuxcnc, fanuc, csv, features (the fitted features a CMM reports, docs/formats.md), cmm, qif, dmis or gauge")
       ->check(CLI::IsMember({"auto", "linuxcnc", "fanuc", "csv", "features", "cmm", "qif", "dmis", "gauge"}))->capture_default_str();
   ev->add_flag("--free-radius", a->free_radius, "sphere centres from the free-radius fit (default: known radius)");
-  ev->add_flag("--strict", a->strict, "QIF export: refuse what the lenient reader reads with a warning (docs/interop.md)");
+  ev->add_flag("--strict", a->strict, "QIF or DMIS input: refuse what the lenient reader reads with a warning (docs/interop.md)");
   ev->add_option("--scene", a->scene, "also write a glTF scene (the sphere campaign, or the test piece with its deviations)");
   ev->add_option("--exaggeration", a->exaggeration, "scale of the error vectors in the scene (default: 10000 sphere campaign, 1000 test piece)");
   ev->add_option("--gauge-resolution-um", a->gauge_resolution_um,

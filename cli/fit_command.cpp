@@ -78,7 +78,7 @@ Subcommand addFitCommand(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "csv", "ds", "xyz", "ply", "qif", "dmis"}))->capture_default_str();
   fit->add_option("--feature", fa->feature, "points CSV: use the rows of this feature only; QIF/DMIS: this feature's measured "
                   "points (required when the file holds several)");
-  fit->add_flag("--strict", fa->strict, "QIF: refuse what the lenient reader would read with a warning (docs/interop.md)");
+  fit->add_flag("--strict", fa->strict, "QIF or DMIS: refuse what the lenient reader would read with a warning (docs/interop.md)");
   fit->add_option("--cycle", fa->cycle, "points CSV: use the rows of this cycle only (required when the file holds several)");
   fit->add_option("--tip-radius", fa->tip_radius_mm, "stylus tip radius, mm: the points are tip centres")->capture_default_str();
   fit->add_option("--material", fa->material, "material side for tip compensation when the file has no approach directions: inside (ball, shaft) or outside (bore)")

@@ -29,7 +29,7 @@ int runRead(const ReadArgs& a) {
   }
   if (interop::looksLikeDmis(text)) {  // a program (DMISMN: its nominals and PTMEAS points) or output (FILNAM)
     const bool program = interop::isDmisProgram(text);
-    const auto d = program ? interop::parseDmisProgram(text, a.file)
+    const auto d = program ? interop::parseDmisProgram(text, a.file, interop::CmmReadOptions{a.strict})
                            : interop::parseDmisOutput(text, a.file, interop::CmmReadOptions{a.strict});
     std::fputs((a.json ? interop::cmmDocumentJson(d) : interop::cmmDocumentText(d)).c_str(), stdout);
     return 0;
@@ -53,8 +53,9 @@ Subcommand addReadCommand(CLI::App& app) {
                                 "program): features, points, units");
   rd->add_option("file", a->file, "QIF 3.0 or DMIS file")->required()->check(inputFile());
   rd->add_flag("--json", a->json, "print JSON (every feature with its geometry and points, in mm; the warnings)");
-  rd->add_flag("--strict", a->strict, "QIF: refuse what the lenient reader reads with a warning (element order, a dangling or "
-               "self-referencing id, an unknown extension, a missing PointList), at its line");
+  rd->add_flag("--strict", a->strict, "refuse what the lenient reader reads with a warning, at its line (QIF: element order, a "
+               "dangling or self-referencing id, an unknown extension, a missing PointList; DMIS: a missing ENDFIL or ENDMES, "
+               "statements after ENDFIL, a label defined again)");
   return {rd, [a] { return runRead(*a); }};
 }
 

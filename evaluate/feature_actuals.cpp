@@ -195,7 +195,7 @@ std::optional<StatedFeatureFile> readStatedFeatures(const std::string& path, con
                                                       "each run to its own file");
   out.format = qif ? "qif" : "dmis";
   out.rows = featureActualsFromCmm(d);
-  for (const auto& w : d.warnings) out.warnings.push_back(path + ":" + std::to_string(w.line) + ": " + w.what);
+  out.warnings = inputWarnings(d);
   return out;
 }
 

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "evaluate/input_warnings.hpp"
 #include "interop/cmm_document.hpp"
 #include "parts/plan_manifest.hpp"
 
@@ -74,7 +75,7 @@ bool holdsOnlyFeatures(const interop::CmmDocument& d);
 struct StatedFeatureFile {
   std::string format;  // features | qif | dmis
   std::vector<FeatureActual> rows;
-  std::vector<std::string> warnings;
+  std::vector<InputWarning> warnings;
 };
 std::optional<StatedFeatureFile> readStatedFeatures(const std::string& path, const std::string& text, bool strict);
 

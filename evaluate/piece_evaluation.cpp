@@ -14,6 +14,7 @@
 #include "core/error.hpp"
 #include "core/input_file.hpp"
 #include "evaluate/feature_actuals.hpp"
+#include "evaluate/input_warnings.hpp"
 #include "interop/qif.hpp"
 #include "evaluate/ingest.hpp"
 #include "evaluate/sw_features.hpp"
@@ -46,6 +47,7 @@ EvaluationFiles sphere(const parts::PlanManifest& planned, const EvaluateRequest
   EvaluateOptions opt;
   opt.known_radius = !r.free_radius;
   EvaluationFiles f;
+  std::vector<InputWarning> warnings;  // the QIF reader's (lenient reading)
   std::string text;
   // auto: a CSV with the feature-actuals columns is one (the points CSV has none of i,j,k,n_points).
   if (r.format == "features" || (r.format == "auto" && std::filesystem::is_regular_file(r.input_file))) text = readFile(r.input_file);
@@ -56,7 +58,8 @@ EvaluationFiles sphere(const parts::PlanManifest& planned, const EvaluateRequest
   } else if (r.format == "qif") {
     // The measured sphere features of a QIF 3.0 Results file, one MeasurementResults per cycle.
     // (A DMIS output holds one run: a campaign's cycles cannot be told apart in it; not read yet.)
-    const auto doc = interop::parseQifResults(readFile(r.input_file), r.input_file);
+    const auto doc = interop::parseQifResults(readFile(r.input_file), r.input_file, interop::CmmReadOptions{r.strict});
+    warnings = inputWarnings(doc);
     f.sphere = evaluateSphereCampaignFromFeatures(m, sphereCentresFromFeatures(featureActualsFromCmm(doc, m.cycles), m), r.input_file, opt);
   } else {
     if (r.format != "auto" && r.format != "linuxcnc" && r.format != "fanuc" && r.format != "csv")
@@ -66,8 +69,8 @@ EvaluationFiles sphere(const parts::PlanManifest& planned, const EvaluateRequest
   }
   const auto& e = *f.sphere;
   f.errors_csv = errorSeriesCsv(e);
-  f.evaluation_json = evaluationJson(e, m);
-  f.report_md = evaluationReport(e, m);
+  f.evaluation_json = withInputWarnings(evaluationJson(e, m), warnings);
+  f.report_md = withInputWarningsSection(evaluationReport(e, m), warnings);
   f.stdout_text = sphereEvaluationStdout(e, r.out_dir);
   if (e.from_features)
     f.stdout_text = "Sphere centres from the feature file " + r.input_file + " (no points; " + std::to_string(e.other_features) +
@@ -88,14 +91,8 @@ EvaluationFiles sphere(const parts::PlanManifest& planned, const EvaluateRequest
       f.stdout_text += std::string("Rotary axes not calibrated: ") + g.what() + "\n";
     }
   }
+  f.stdout_text += inputWarningLines(warnings);
   return f;
-}
-
-// The input file's reader warnings, one "warning: file:line: ..." line each, after the results.
-std::string warningLines(const std::vector<std::string>& warnings) {
-  std::string o;
-  for (const auto& w : warnings) o += "warning: " + w + "\n";
-  return o;
 }
 
 // The features a CMM states, when the file holds no points (issue 34): a feature CSV, or a QIF /
@@ -114,7 +111,7 @@ EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateReq
   opt.gauge_resolution_um = r.gauge_resolution_um;
   TtpEvaluation e;
   std::optional<TtpPoints> points;
-  std::vector<std::string> warnings;
+  std::vector<InputWarning> warnings;
   // Only the fitted features, no points (issue 34): the plan's points placed on them.
   const auto stated = statedFeatures(fmt, r, text);
   if (stated) {
@@ -122,6 +119,7 @@ EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateReq
     warnings = stated->warnings;
   } else if (fmt == "cmm" || fmt == "qif" || fmt == "dmis") {  // a CSV export, QIF 3.0 Results or DMIS output
     points = readTtpCmmExport(r.input_file, text, m, r.strict);
+    warnings = points->warnings;
     e = evaluateThermalTestPiece(m, *points, opt);
   } else if (fmt == "linuxcnc" || fmt == "fanuc" || fmt == "log" || fmt == "csv") {
     points = readTtpOnMachine(r.input_file, text, fmt, m);
@@ -136,12 +134,11 @@ EvaluationFiles thermalTestPiece(const parts::PlanManifest& m, const EvaluateReq
   EvaluationFiles f;
   f.errors_csv = ttpErrorsCsv(e);
   f.results_qif = evaluationQif(m, points ? &*points : nullptr, f.errors_csv);
-  f.evaluation_json = ttpEvaluationJson(e);
-  f.report_md = ttpReport(e);
+  f.evaluation_json = withInputWarnings(ttpEvaluationJson(e), warnings);
+  f.report_md = withInputWarningsSection(ttpReport(e), warnings);
   f.stdout_text = ttpStdout(e, pathIn(r.out_dir, EvaluationFiles::kErrorsCsv), pathIn(r.out_dir, EvaluationFiles::kEvaluationJson),
                             pathIn(r.out_dir, EvaluationFiles::kReportMd));
-  if (points) warnings = points->warnings;
-  f.stdout_text += warningLines(warnings);
+  f.stdout_text += inputWarningLines(warnings);
   f.thermal_test_piece = std::move(e);
   return f;
 }
@@ -171,11 +168,11 @@ EvaluationFiles steppedWorkpiece(const parts::PlanManifest& m, const EvaluateReq
     if (!r.compare_with.empty()) compareWithBefore(*f.stepped_workpiece, m, r.compare_with);
     const auto& e = *f.stepped_workpiece;
     f.errors_csv = swErrorsCsv(e);
-    f.evaluation_json = swEvaluationJson(e);
-    f.report_md = swReport(e);
+    f.evaluation_json = withInputWarnings(swEvaluationJson(e), stated->warnings);
+    f.report_md = withInputWarningsSection(swReport(e), stated->warnings);
     f.compensation_json = swCompensationFile(e);
     f.results_qif = evaluationQif(m, nullptr, f.errors_csv);  // no measured points to write
-    f.stdout_text = swFromFeaturesStdout(*e.from_features) + swStdout(e, r.out_dir) + warningLines(stated->warnings);
+    f.stdout_text = swFromFeaturesStdout(*e.from_features) + swStdout(e, r.out_dir) + inputWarningLines(stated->warnings);
     return f;
   }
   const auto cmm = readTtpCmmExport(r.input_file, text, m, r.strict);
@@ -183,11 +180,11 @@ EvaluationFiles steppedWorkpiece(const parts::PlanManifest& m, const EvaluateReq
   if (!r.compare_with.empty()) compareWithBefore(*f.stepped_workpiece, m, r.compare_with);
   const auto& e = *f.stepped_workpiece;
   f.errors_csv = swErrorsCsv(e);
-  f.evaluation_json = swEvaluationJson(e);
-  f.report_md = swReport(e);
+  f.evaluation_json = withInputWarnings(swEvaluationJson(e), cmm.warnings);
+  f.report_md = withInputWarningsSection(swReport(e), cmm.warnings);
   f.compensation_json = swCompensationFile(e);
   f.results_qif = evaluationQif(m, &cmm, f.errors_csv);
-  f.stdout_text = swStdout(e, r.out_dir) + warningLines(cmm.warnings);
+  f.stdout_text = swStdout(e, r.out_dir) + inputWarningLines(cmm.warnings);
   return f;
 }
 

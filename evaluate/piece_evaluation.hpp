@@ -29,7 +29,7 @@ struct EvaluateRequest {
   double gauge_resolution_um = 1.0;  // thermal test piece, dial-gauge route (not stated in the thesis)
   std::string probe_log;         // stepped workpiece: the on-machine probe log beside the CMM export (input_file)
   std::string cycle_starts;      // sphere artifact: a user's cycle start times (ingest.hpp applyCycleStarts)
-  bool strict = false;           // QIF exports: refuse what the lenient reader would warn about
+  bool strict = false;           // QIF/DMIS inputs: refuse what the lenient reader would warn about
 };
 
 struct EvaluationFiles {

@@ -14,7 +14,7 @@
 //   properties of any scalar type; other elements and properties are skipped.
 // - qif, dmis: a QIF 3.0 Results document or a DMIS output file (interop/): the measured points
 //   of the feature --feature names (required when more than one feature has points; an error
-//   lists them). The reader's warnings (lenient reading, docs/interop.md#lenient-reading) are
+//   lists them; a DMIS label in any case, as DMIS labels are case-insensitive). The reader's warnings (lenient reading, docs/interop.md#lenient-reading) are
 //   returned in warnings, "file:line: what was wrong; what was done"; select.strict refuses them.
 // - auto: by extension (.csv, .ds, .xyz/.txt/.asc, .ply, .qif, .dmo).
 // - Every bad line is an InputError with file:line and what was expected; NaN and inf are

@@ -1,5 +1,7 @@
 // `probeloop fit` on a CMM exchange file: the measured points of one feature of a QIF 3.0
 // Results document or a DMIS output file (evaluate/point_cloud.hpp has the contract).
+#include <algorithm>
+#include <cctype>
 #include <set>
 
 #include "core/error.hpp"
@@ -30,8 +32,12 @@ void readCmmExchange(PointCloud& pc, const std::string& text, const PointSelecti
       throw InputError(pc.file, 0, std::to_string(with_points.size()) + " " + what + " (" + names + "): give --feature NAME");
     chosen = with_points;
   } else {
+    // DMIS labels are case-insensitive (the reader keeps them upper case); QIF names are not.
+    std::string want = select.feature;
+    if (pc.format != "qif")
+      std::transform(want.begin(), want.end(), want.begin(), [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
     for (const auto& f : d.features)
-      if (f.name == select.feature) chosen.push_back(&f);
+      if (f.name == want) chosen.push_back(&f);
     if (chosen.empty()) throw InputError(pc.file, 0, "no feature named '" + select.feature + "'; " + what + ": " + names);
     if (chosen.size() > 1)
       throw InputError(pc.file, chosen[1]->line, "feature '" + select.feature + "' is measured " + std::to_string(chosen.size()) +

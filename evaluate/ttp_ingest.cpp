@@ -287,7 +287,7 @@ TtpPoints cmmResults(const std::string& path, const std::string& text, const par
                                   std::to_string(d.features.size()) +
                                   " measured features: the evaluation fits its own planes and needs the points");
   auto out = cmmPointsFromRows(path, qif ? "qif" : "dmis", rows, true, m);
-  for (const auto& w : d.warnings) out.warnings.push_back(path + ":" + std::to_string(w.line) + ": " + w.what);
+  out.warnings = inputWarnings(d);
   return out;
 }
 

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "evaluate/input_warnings.hpp"
 #include "parts/plan_manifest.hpp"
 
 namespace probeloop::evaluate {
@@ -45,7 +46,7 @@ struct TtpPoints {
   TtpRoute route = TtpRoute::Cmm;
   std::string assigned_by;  // labels | nominal geometry | manifest positions
   std::vector<TtpPoint> points;
-  std::vector<std::string> warnings;  // what the exchange file's lenient reader warned about
+  std::vector<InputWarning> warnings;  // what the exchange file's lenient reader warned about
 };
 
 struct TtpGaugeReading {
@@ -66,7 +67,7 @@ struct TtpGaugeReadings {
 std::string detectTtpFormat(const std::string& path, const std::string& text);
 
 // QIF and DMIS exports are read leniently (docs/interop.md#lenient-reading): the reader's
-// warnings land in TtpPoints::warnings ("file:line: ..."); strict refuses them instead.
+// warnings land in TtpPoints::warnings (file, line, what); strict refuses them instead.
 TtpPoints readTtpCmmExport(const std::string& path, const std::string& text, const parts::PlanManifest& m, bool strict = false);
 // format: csv (the points CSV) or linuxcnc | fanuc | log (a PT log).
 TtpPoints readTtpOnMachine(const std::string& path, const std::string& text, const std::string& format,

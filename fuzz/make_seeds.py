@@ -205,4 +205,10 @@ put("dmis", "hostile_counts.dmo", "DMISMN/'x',05.3\nUNITS/MM,ANGDEC\nF(S1)=FEAT/
     "PTMEAS/CART,nan,0,0,0,0,1\nENDMES\nENDFIL\n")
 put("dmis", "hostile_truncated.dmi", "DMISMN/'x',05.3\nUNITS/MM,ANGDEC\nF(S1)=FEAT/SPHERE,OUTER,CART,0,0")
 put("dmis", "hostile_continuation.dmi", "DMISMN/'x',05.3\n" + "F(A)=FEAT/PLANE,CART,$\n" * 2000 + "ENDFIL\n")
+# The lenient reader's paths (issue 34): labels defined and reported again, a MEAS block without
+# ENDMES, a stray ENDMES, statements after ENDFIL, a missing ENDFIL.
+put("dmis", "hostile_lenient.dmi", "DMISMN/'x',05.3\nF(A)=FEAT/PLANE,CART,0,0,0,0,0,1\nF(A)=FEAT/PLANE,CART,0,0,5,0,0,1\n"
+    "MEAS/PLANE,F(A),1\nPTMEAS/CART,1,2,5,0,0,1\nMEAS/PLANE,F(A),1\nPTMEAS/CART,3,4,5,0,0,1\nENDMES\nENDMES\nENDFIL\nGOTO/0,0,1\n")
+put("dmis", "hostile_lenient.dmo", "FILNAM/'x'\nFA(C)=FEAT/CYLNDR,INNER,CART,0,0,0,0,0,1,10\nFA(C_P01)=FEAT/POINT,CART,5,0,0,1,0,0\n"
+    "FA(C_P01)=FEAT/POINT,CART,5.1,0,0,1,0,0\nFA(C)=FEAT/CYLNDR,INNER,CART,0,0,0,0,0,1,10.2\nFA(C)=FEAT/PLANE,CART,0,0,0,0,0,1\n")
 print("seeds written under", C)

@@ -330,7 +330,7 @@ bool isDmisProgram(const std::string& text) {
   return false;
 }
 
-CmmDocument parseDmisProgram(const std::string& text, const std::string& file_name) {
+CmmDocument parseDmisProgram(const std::string& text, const std::string& file_name, const CmmReadOptions& options) {
   Parser p(file_name);
   CmmDocument d;
   d.file = file_name;
@@ -340,8 +340,29 @@ CmmDocument parseDmisProgram(const std::string& text, const std::string& file_na
   std::size_t meas = none;  // an index: the vector may grow
   std::size_t expected = 0;
   int meas_line = 0;
-  for (const auto& s : statements(text)) {
+  auto lenient = [&](int line, const std::string& problem, const std::string& done) {
+    if (options.strict) p.fail(line, problem);
+    d.warnings.push_back({line, problem + "; " + done});
+  };
+  // A block whose ENDMES is missing but whose PTMEAS count is its n: closed where the next
+  // block, ENDFIL or the end of the file shows it ended (a count that does not add up is refused).
+  auto closeUnended = [&](int line, const std::string& where) {
+    const auto& f = d.features[meas];
+    if (f.points.size() != expected)
+      p.fail(meas_line, "MEAS: no ENDMES, and " + std::to_string(f.points.size()) + " PTMEAS where MEAS/..,F(" + f.name + ")," +
+                            std::to_string(expected) + " announced");
+    lenient(line, "the MEAS block of line " + std::to_string(meas_line) + " has no ENDMES",
+            "closed " + where + " (its " + std::to_string(expected) + " PTMEAS as announced)");
+    meas = none;
+  };
+  const auto all_statements = statements(text);
+  bool ended = false;
+  for (const auto& s : all_statements) {
     std::string prefix, lab, rest;
+    if (ended) {
+      lenient(s.line, "statements after ENDFIL", "passed over");
+      break;
+    }
     requireLabel(p, s);
     if (s.text.rfind("UNITS/", 0) == 0) {
       units(p, s);
@@ -355,10 +376,19 @@ CmmDocument parseDmisProgram(const std::string& text, const std::string& file_na
         ++skipped["FEAT/" + rest.substr(5, rest.find(',') - 5)];
         continue;
       }
+      const auto again = index.find(lab);
+      if (again != index.end()) {
+        // A label defined again: DMIS's later definition replaces the earlier one.
+        lenient(s.line, "F(" + lab + ") defined again (first at line " + std::to_string(d.features[again->second].line) + ")",
+                "the later definition read");
+        f.points = std::move(d.features[again->second].points);  // measured before: kept
+        d.features[again->second] = f;
+        continue;
+      }
       index[lab] = d.features.size();
       d.features.push_back(f);
     } else if (s.text.rfind("MEAS/", 0) == 0) {
-      if (meas != none) p.fail(s.line, "MEAS: the MEAS block of line " + std::to_string(meas_line) + " has no ENDMES");
+      if (meas != none) closeUnended(s.line, "before the MEAS of this line");
       const auto a = split(s.text.substr(5));
       if (a.size() < 3 || a[1].rfind("F(", 0) != 0 || a[1].back() != ')') p.fail(s.line, "MEAS: expected MEAS/<type>,F(label),n");
       const std::string l = a[1].substr(2, a[1].size() - 3);
@@ -383,21 +413,27 @@ CmmDocument parseDmisProgram(const std::string& text, const std::string& file_na
       const std::size_t at = a[0] == "CART" ? 1 : 0;
       d.moves.push_back({s.line, p.point(s.line, a, at, "GOTO"), false});
     } else if (s.text == "ENDMES") {
-      if (meas == none) p.fail(s.line, "ENDMES without MEAS");
+      if (meas == none) {
+        lenient(s.line, "ENDMES without MEAS", "passed over");
+        continue;
+      }
       const auto& f = d.features[meas];
       if (f.points.size() != expected)
         p.fail(meas_line, "MEAS/..,F(" + f.name + ")," + std::to_string(expected) + ": " + std::to_string(f.points.size()) +
                               " PTMEAS in the block");
       meas = none;
     } else if (s.text.rfind("ENDFIL", 0) == 0) {
-      break;
+      if (meas != none) closeUnended(s.line, "at ENDFIL");
+      ended = true;
     } else if (s.text.rfind("DMISMN", 0) == 0 || s.text.rfind("DMISMD", 0) == 0) {
       continue;  // the header
     } else {
       ++skipped[keyword(s.text)];
     }
   }
-  if (meas != none) p.fail(meas_line, "MEAS: no ENDMES");
+  if (meas != none) closeUnended(all_statements.back().line, "at the end of the file");
+  if (!ended && !all_statements.empty())
+    lenient(all_statements.back().line, "no ENDFIL after the last statement (the file may be cut short)", "what is there was read");
   d.length_unit = unitName(p.mm_per_unit);
   noteSkipped(d, skipped);
   return d;
@@ -415,6 +451,7 @@ CmmDocument parseDmisOutput(const std::string& text, const std::string& file_nam
     bool actual = false;
   };
   std::vector<Actual> all;
+  std::map<std::string, std::pair<std::size_t, int>> seen;  // "F(X)" / "FA(X)" -> its place in all, its first line
   std::map<std::string, int> skipped;
   const auto all_statements = statements(text);
   bool ended = false;
@@ -444,6 +481,19 @@ CmmDocument parseDmisOutput(const std::string& text, const std::string& file_nam
         ++skipped["FEAT/" + rest.substr(5, rest.find(',') - 5)];
         continue;
       }
+      const std::string key = prefix + "(" + lab + ")";
+      if (const auto again = seen.find(key); again != seen.end()) {
+        // Reported again (a feature measured twice, a point re-taken): the later report is the
+        // result. Its kind must agree: another kind is another meaning.
+        auto& earlier = all[again->second.first];
+        if (earlier.f.kind != a.f.kind)
+          p.fail(s.line, key + "=FEAT/: a " + cmmFeatureKindName(a.f.kind) + ", but line " + std::to_string(earlier.f.line) + " makes " +
+                             lab + " a " + cmmFeatureKindName(earlier.f.kind));
+        lenient(s.line, key + " reported again (first at line " + std::to_string(again->second.second) + ")", "the later one read");
+        earlier = a;
+        continue;
+      }
+      seen[key] = {all.size(), s.line};
       all.push_back(a);
       continue;
     }

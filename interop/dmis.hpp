@@ -26,7 +26,8 @@
 // they do not read (tolerances, datums, OUTPUT, GOTO, sensor and report statements), are skipped
 // and counted in one note per keyword. InputError with file:line for a statement that does not
 // parse, a number that is not one, a MEAS block whose PTMEAS count differs from its n, a PTMEAS
-// outside a MEAS block, a MEAS without ENDMES, a MEAS of a feature not defined before it.
+// outside a MEAS block, a MEAS of a feature not defined before it, a label reused for another
+// kind of feature.
 #pragma once
 #include <string>
 
@@ -37,10 +38,14 @@ namespace probeloop::interop {
 std::string dmisProgram(const CmmDocument& plan, const std::string& title);
 std::string dmisOutput(const CmmDocument& results, const std::string& title);
 
-CmmDocument parseDmisProgram(const std::string& text, const std::string& file_name);
-// Lenient (docs/interop.md#lenient-reading): an output without ENDFIL (perhaps cut short: what
-// is there is read) and statements after ENDFIL (passed over) are warnings with their line;
-// options.strict refuses them.
+// Lenient (docs/interop.md#lenient-reading), both readers: a file without ENDFIL (perhaps cut
+// short: what is there is read), statements after ENDFIL (passed over), and a label defined or
+// reported again (the later one read: F(X) twice in a program or an output, FA(X) twice in an
+// output) are warnings with their line. A program's MEAS block without its ENDMES is closed at
+// the next MEAS, ENDFIL or the end of the file when its PTMEAS count is its n (a count that does
+// not add up stays refused), and an ENDMES without MEAS is passed over. options.strict refuses
+// each at the same line, with the warning's first words.
+CmmDocument parseDmisProgram(const std::string& text, const std::string& file_name, const CmmReadOptions& options = {});
 CmmDocument parseDmisOutput(const std::string& text, const std::string& file_name, const CmmReadOptions& options = {});
 
 // A DMIS text: its first statement (after comments) is DMISMN or FILNAM (DMISMD); a program

@@ -152,11 +152,91 @@ TEST(Dmis, AMissingEndfilAndStatementsAfterItAreWarned) {
   }
 }
 
+void expectStrictRefusal(const std::string& text, const std::string& file, const std::string& want, bool program) {
+  try {
+    if (program) parseDmisProgram(text, file, CmmReadOptions{true});
+    else parseDmisOutput(text, file, CmmReadOptions{true});
+    ADD_FAILURE() << "strict read accepted: " << want;
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(want, 0), 0u) << e.what();
+  }
+}
+
+// Lenient programs (issue 34 item 2): a label defined again (the later definition read), a MEAS
+// block whose ENDMES is missing but whose count adds up (closed at the next MEAS), a stray
+// ENDMES and a statement after ENDFIL are read with a warning at their line; strict refuses
+// the first of them there.
+TEST(Dmis, AProgramsFormMistakesAreWarned) {
+  const std::string text =
+      "DMISMN/'x',05.2\n"                  // 1
+      "F(A)=FEAT/PLANE,CART,0,0,0,0,0,1\n"  // 2
+      "F(A)=FEAT/PLANE,CART,0,0,5,0,0,1\n"  // 3: defined again
+      "MEAS/PLANE,F(A),1\n"                 // 4
+      "PTMEAS/CART,1,2,5,0,0,1\n"           // 5
+      "MEAS/PLANE,F(A),1\n"                 // 6: the block of line 4 had no ENDMES
+      "PTMEAS/CART,3,4,5,0,0,1\n"           // 7
+      "ENDMES\n"                            // 8
+      "ENDMES\n"                            // 9: without MEAS
+      "ENDFIL\n"                            // 10
+      "GOTO/0,0,100\n";                     // 11: after ENDFIL
+  const auto d = parseDmisProgram(text, "odd.dmi");
+  ASSERT_EQ(d.features.size(), 1u);
+  EXPECT_EQ(d.features[0].nominal.location_mm.z(), 5.0);  // the later definition
+  ASSERT_EQ(d.features[0].points.size(), 1u);             // the second block's point
+  EXPECT_EQ(d.features[0].points[0].p_mm, Eigen::Vector3d(3, 4, 5));
+  EXPECT_EQ(d.moves.size(), 2u);  // the PTMEAS; the GOTO after ENDFIL passed over
+  ASSERT_EQ(d.warnings.size(), 4u);
+  const std::vector<std::pair<int, std::string>> want = {
+      {3, "F(A) defined again (first at line 2); the later definition read"},
+      {6, "the MEAS block of line 4 has no ENDMES; closed before the MEAS of this line (its 1 PTMEAS as announced)"},
+      {9, "ENDMES without MEAS; passed over"},
+      {11, "statements after ENDFIL; passed over"}};
+  for (std::size_t i = 0; i < want.size(); ++i) {
+    EXPECT_EQ(d.warnings[i].line, want[i].first);
+    EXPECT_EQ(d.warnings[i].what, want[i].second);
+  }
+  expectStrictRefusal(text, "odd.dmi", "odd.dmi:3: F(A) defined again (first at line 2)", true);
+  // The block closed at ENDFIL, and a program without ENDFIL.
+  const auto e = parseDmisProgram("DMISMN/'x'\nF(A)=FEAT/PLANE,CART,0,0,0,0,0,1\nMEAS/PLANE,F(A),1\nPTMEAS/CART,0,0,0,0,0,1\n", "cut.dmi");
+  ASSERT_EQ(e.warnings.size(), 2u);
+  EXPECT_EQ(e.warnings[0].what, "the MEAS block of line 3 has no ENDMES; closed at the end of the file (its 1 PTMEAS as announced)");
+  EXPECT_EQ(e.warnings[1].line, 4);
+  EXPECT_EQ(e.features[0].points.size(), 1u);
+  EXPECT_TRUE(parseDmisProgram("DMISMN/'x'\nF(A)=FEAT/PLANE,CART,0,0,0,0,0,1\nMEAS/PLANE,F(A),1\nPTMEAS/CART,0,0,0,0,0,1\nENDMES\nENDFIL\n",
+                               "ok.dmi").warnings.empty());
+}
+
+// Lenient outputs: a feature or a point reported again is read from its later report, with a
+// warning; another kind under the same label stays refused (another meaning).
+TEST(Dmis, AnOutputsLabelReportedAgainKeepsTheLaterReport) {
+  const std::string text =
+      "FILNAM/'x'\n"                                    // 1
+      "FA(C)=FEAT/CYLNDR,INNER,CART,0,0,0,0,0,1,10\n"   // 2
+      "FA(C_P01)=FEAT/POINT,CART,5,0,0,1,0,0\n"          // 3
+      "FA(C_P01)=FEAT/POINT,CART,5.1,0,0,1,0,0\n"        // 4: re-taken
+      "FA(C)=FEAT/CYLNDR,INNER,CART,0,0,0,0,0,1,10.2\n"  // 5: reported again
+      "ENDFIL\n";
+  const auto d = parseDmisOutput(text, "again.dmo");
+  ASSERT_EQ(d.features.size(), 1u);
+  EXPECT_EQ(d.features[0].measured.diameter_mm, 10.2);
+  ASSERT_EQ(d.features[0].points.size(), 1u);
+  EXPECT_EQ(d.features[0].points[0].p_mm.x(), 5.1);
+  ASSERT_EQ(d.warnings.size(), 2u);
+  EXPECT_EQ(d.warnings[0].line, 4);
+  EXPECT_EQ(d.warnings[0].what, "FA(C_P01) reported again (first at line 3); the later one read");
+  EXPECT_EQ(d.warnings[1].line, 5);
+  expectStrictRefusal(text, "again.dmo", "again.dmo:4: FA(C_P01) reported again (first at line 3)", false);
+  expectRefused("FILNAM/'x'\nFA(X)=FEAT/PLANE,CART,0,0,0,0,0,1\nFA(X)=FEAT/SPHERE,OUTER,CART,0,0,0,5\nENDFIL\n",
+                "bad.dmo:3: FA(X)=FEAT/: a sphere, but line 2 makes X a plane", false);
+}
+
 TEST(Dmis, RefusesWhatDoesNotAddUp) {
   const std::string f = "DMISMN/'x',05.2\nF(A)=FEAT/PLANE,CART,0,0,0,0,0,1\n";
   expectRefused(f + "MEAS/PLANE,F(A),3\nPTMEAS/CART,0,0,0,0,0,1\nENDMES\n", "bad.dmi:3: MEAS/..,F(A),3: 1 PTMEAS in the block");
   expectRefused(f + "PTMEAS/CART,0,0,0,0,0,1\n", "bad.dmi:3: PTMEAS outside a MEAS block");
-  expectRefused(f + "MEAS/PLANE,F(A),1\nPTMEAS/CART,0,0,0,0,0,1\n", "bad.dmi:3: MEAS: no ENDMES");
+  expectRefused(f + "MEAS/PLANE,F(A),2\nPTMEAS/CART,0,0,0,0,0,1\n", "bad.dmi:3: MEAS: no ENDMES, and 1 PTMEAS where MEAS/..,F(A),2 announced");
+  expectRefused(f + "MEAS/PLANE,F(A),2\nPTMEAS/CART,0,0,0,0,0,1\nMEAS/PLANE,F(A),1\n",
+                "bad.dmi:3: MEAS: no ENDMES, and 1 PTMEAS where MEAS/..,F(A),2 announced");
   expectRefused(f + "MEAS/PLANE,F(B),1\n", "bad.dmi:3: MEAS: F(B) is not defined");
   expectRefused(f + "MEAS/PLANE,F(A),1\nPTMEAS/CART,0,0,1O,0,0,1\nENDMES\n", "bad.dmi:4: PTMEAS: '1O' is not a number");
   expectRefused("FILNAM/'x'\nFA(A)=FEAT/PLANE,CART,0,0,0\n", "bad.dmo:2: FEAT/PLANE: expected i,j,k", false);

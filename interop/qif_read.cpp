@@ -7,6 +7,7 @@
 #include <optional>
 #include <set>
 #include <sstream>
+#include <vector>
 
 #include "core/atomic_file.hpp"
 #include "core/csv.hpp"
@@ -334,13 +335,20 @@ CmmDocument parseQifResults(const std::string& xml, const std::string& file_name
         }
       d.features.push_back(std::move(f));
     }
-    if (const auto* mc = child(mr, "MeasuredCharacteristics"))
+    if (const auto* mc = child(mr, "MeasuredCharacteristics")) {
+      // A measurement with only its status (Value is optional in QIF): nothing to read; counted
+      // in a note, so that a converter that lost values says so.
+      std::vector<std::string> without_value;
       for (const auto* c : children(child(mc, "CharacteristicMeasurements"))) {
         const auto* v = child(c, "Value");
-        if (!v) continue;
-        CmmCharacteristic ch;
         const auto* item = child(c, "CharacteristicItemId");
-        ch.name = item && char_item_name.count(text(item)) ? char_item_name[text(item)] : local(c);
+        const std::string name = item && char_item_name.count(text(item)) ? char_item_name[text(item)] : local(c);
+        if (!v) {
+          without_value.push_back(name);
+          continue;
+        }
+        CmmCharacteristic ch;
+        ch.name = name;
         // Angles: the user-defined angular and the angle types (not Angularity, a zone in length).
         const std::string t = local(c);
         ch.angular = t.rfind("UserDefinedAngular", 0) == 0 || t.rfind("Angle", 0) == 0 || t.rfind("AngularCoordinate", 0) == 0;
@@ -350,6 +358,13 @@ CmmDocument parseQifResults(const std::string& xml, const std::string& file_name
         if (parseFiniteNumber(attribute(v, "combinedUncertainty"), u)) ch.u = u * scale;
         d.characteristics.push_back(ch);
       }
+      if (!without_value.empty()) {
+        std::string names;
+        for (std::size_t i = 0; i < without_value.size() && i < 6; ++i) names += (i ? ", " : "") + without_value[i];
+        d.notes.push_back(std::to_string(without_value.size()) + " characteristic measurement" + (without_value.size() > 1 ? "s" : "") +
+                          " without a Value (" + names + (without_value.size() > 6 ? ", ..." : "") + "): a status only, not read");
+      }
+    }
   }
   d.runs = run;
   return d;

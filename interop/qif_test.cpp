@@ -219,6 +219,14 @@ TEST(Qif, FeaturesWithoutPointsAndAnglesInDegrees) {
   EXPECT_NEAR(r.characteristics[0].value, M_PI / 2, 1e-12);
   EXPECT_FALSE(r.characteristics[1].angular);
   EXPECT_NEAR(r.characteristics[1].value, 0.095, 1e-12);
+  EXPECT_TRUE(r.notes.empty()) << r.notes.front();
+  // A measurement with a status only (Value is optional; a converter may lose it): named in a note.
+  std::string status_only = xml;
+  status_only.replace(status_only.find("<Value>0.095</Value>"), 20, "<Status><CharacteristicStatusEnum>FAIL</CharacteristicStatusEnum></Status>");
+  const auto s = parseQifResults(status_only, "s.qif");
+  ASSERT_EQ(s.characteristics.size(), 1u);
+  ASSERT_EQ(s.notes.size(), 1u);
+  EXPECT_EQ(s.notes[0], "1 characteristic measurement without a Value (AngularityCharacteristicMeasurement): a status only, not read");
 }
 
 // Other software's files (../shared/refdata/qif3/samples); the expected numbers are what

@@ -467,6 +467,7 @@ std::string sphereCampaignReportHtml(const json& evaluation, const std::string* 
   scatterAndRepeatability(page, evaluation);
   budgetSection(page, evaluation);
   page.html += "</section>\n";
+  page.html += inputWarningsSection(evaluation);
   scheduleSection(page, evaluation, manifest);
 
   std::string out =

@@ -495,6 +495,7 @@ std::string steppedWorkpieceReportHtml(const json& eval, const std::string& file
     page.html += "</ul>\n";
   }
   page.html += "</section>\n";
+  for (const auto& p : parts) page.html += inputWarningsSection(*p.eval);
 
   std::string out = "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
                     "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<meta name=\"generator\" "

@@ -179,6 +179,8 @@ std::string thermalTestPieceReportHtml(const json& evaluation, const json* secon
   const bool printed = hasPrintedForms(routes);
   if (printed) printedFormsNote(page, routes);
   page.html += "</section>\n";
+  page.html += inputWarningsSection(evaluation);
+  if (second_route != nullptr) page.html += inputWarningsSection(*second_route);
   if (printed) printedFormsAppendix(page, routes, t0_s);
 
   std::string out =

@@ -305,6 +305,24 @@ TEST_F(TtpReport, EscapesEveryText) {
   EXPECT_NE(spec(html, 1)["usermeta"]["series"][1]["label"].get<std::string>().find(kEvil), std::string::npos);
 }
 
+// The reader's warnings (issue 34): a section naming file, line and what, escaped; none, and the
+// page unchanged, without them.
+TEST_F(TtpReport, InputWarningsOnlyWhenThereAreSome) {
+  const json clean = evaluation("cmm");
+  json warned = clean;
+  warned["input_warnings"] = json::array({{{"file", "a" + kEvil + ".qif"}, {"line", 1068}, {"what", "WholePointSetId: no set 828; assigned 829"}}});
+  const std::string plain = thermalTestPieceReportHtml(clean, nullptr, nullptr, vega_);
+  const std::string html = thermalTestPieceReportHtml(warned, nullptr, nullptr, vega_);
+  EXPECT_EQ(plain.find("Input warnings"), std::string::npos);
+  EXPECT_NE(html.find("<h2>Input warnings</h2>"), std::string::npos);
+  EXPECT_NE(html.find("line 1068: WholePointSetId: no set 828; assigned 829</li>"), std::string::npos) << html.substr(html.find("Input warnings"), 600);
+  EXPECT_EQ(html.find("alert(\"x"), std::string::npos);
+  // Everything else as the clean page: the section is the only difference.
+  const std::size_t at = html.find("<section class=\"input-warnings\">");
+  const std::size_t end = html.find("</section>\n", at) + 11;
+  EXPECT_EQ(html.substr(0, at) + html.substr(end), plain);
+}
+
 TEST_F(TtpReport, IsDeterministic) {
   const json cmm = evaluation("cmm"), om = evaluation("on_machine");
   const std::string csv = rTestCsv();

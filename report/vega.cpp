@@ -421,6 +421,17 @@ td.ns, .ns { color: #8a8a8a; }
 
 std::string tableWrap(const std::string& table_html) { return "<div class=\"table-wrap\">\n" + table_html + "</div>\n"; }
 
+std::string inputWarningsSection(const json& evaluation) {
+  const json& ws = array(evaluation, "input_warnings");
+  if (ws.empty()) return "";
+  std::string o = "<section class=\"input-warnings\">\n<h2>Input warnings</h2>\n<p class=\"note\">The input file was read "
+                  "leniently (docs/interop.md#lenient-reading): what its producer got wrong without changing the meaning, "
+                  "and what was done. <code>--strict</code> refuses the file instead.</p>\n<ul>\n";
+  for (const auto& w : ws)
+    o += "<li><code>" + esc(text(w, "file")) + "</code> line " + esc(whole(number(w, "line"))) + ": " + esc(text(w, "what")) + "</li>\n";
+  return o + "</ul>\n</section>\n";
+}
+
 std::string hoursMinutes(const std::optional<double>& seconds) {
   if (!seconds || !std::isfinite(*seconds)) return kDash;
   const long long minutes = std::llround(std::abs(*seconds) / 60.0);

@@ -110,5 +110,10 @@ std::string th(const std::string& s, bool num = false);
 std::string tdHtml(const std::string& html, bool num = false);  // `html` is already markup
 std::string td(const std::string& s, bool num = false);
 
+// The input file's reader warnings (evaluation.json's input_warnings [{file, line, what}],
+// issue 34): a section "Input warnings" with one item each, escaped; "" when the evaluation has
+// none, so a page from a clean file is unchanged.
+std::string inputWarningsSection(const json& evaluation);
+
 }  // namespace web
 }  // namespace probeloop::report

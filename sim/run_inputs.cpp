@@ -14,7 +14,10 @@ namespace probeloop::sim {
 void loadCmmRequest(SimulationPart& part, const std::string& file) {
   const std::string text = readFile(file);
   if (interop::looksLikeQif(text) || interop::looksLikeDmis(text)) {  // a QIF plan or a DMIS program: answered in both
-    part.cmm_plan = interop::looksLikeQif(text) ? interop::parseQifPlan(text, file) : interop::parseDmisProgram(text, file);
+    // A program that drives the (virtual) CMM is read strictly, as a controller would run it:
+    // the lenient reading (docs/interop.md#lenient-reading) is for results.
+    part.cmm_plan = interop::looksLikeQif(text) ? interop::parseQifPlan(text, file)
+                                                : interop::parseDmisProgram(text, file, interop::CmmReadOptions{true});
     part.cmm_points = cmmPointsOfQifPlan(*part.cmm_plan);
   } else {
     part.cmm_points = readCmmPoints(file);

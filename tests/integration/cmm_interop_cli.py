@@ -13,6 +13,9 @@
 - DMIS: the plans' cmm_plan.dmi (every PTMEAS of cmm_points.csv, lines within 80 characters)
   drives the simulated CMM, which checks every move against the part as cut and answers with
   cmm_results.dmo; evaluate on it gives the CSV route's errors.csv, every printed digit;
+- the reader's warnings (issue 34 item 4): a vendor extension in the thermal test piece's QIF and
+  a statement after ENDFIL in W8's DMIS output reach stdout, evaluation.json's input_warnings
+  and report.md's section (none in the clean files'), the same errors.csv; --strict refuses them;
 - bad input: a QIF file of another version, a point set whose count does not match its points,
   a DMIS output with a feature we did not plan, and a DMIS program whose move goes through the
   part are refused naming the file, the line and the field, and nothing is written.
@@ -103,6 +106,19 @@ if code == 0:
               c4 == 0 and any(l.startswith(f"warning: {W}/vendor.qif:{ext_line}: MeasurementResults: unknown extension Probe")
                               for l in out4.split("\n"))
               and numbers(f"{T}/ev-vendor/errors.csv") == a, out4[-600:] + e4)
+        # ... and in every output that used the file (issue 34 item 4); the clean file's have none.
+        if c4 == 0:
+            ev4, ev2 = json.load(open(f"{T}/ev-vendor/evaluation.json")), json.load(open(f"{T}/ev-qif/evaluation.json"))
+            iw = ev4.pop("input_warnings", [])
+            check("evaluation.json: input_warnings [{file, line, what}] with the extension's line; nothing else changed "
+                  "(the file's name aside); none in the clean file's",
+                  [(w["file"], w["line"]) for w in iw] == [(f"{W}/vendor.qif", ext_line)]
+                  and iw[0]["what"].startswith("MeasurementResults: unknown extension Probe") and "input_warnings" not in ev2
+                  and json.dumps(ev4).replace(f"{W}/vendor.qif", f"{T}/run/cmm_results.qif") == json.dumps(ev2), iw)
+            r4, r2 = open(f"{T}/ev-vendor/report.md").read(), open(f"{T}/ev-qif/report.md").read()
+            check("report.md: the 'Input warnings' section with the file and line; none in the clean file's",
+                  f"## Input warnings" in r4 and f"- `{W}/vendor.qif` line {ext_line}: MeasurementResults: unknown extension Probe" in r4
+                  and "Input warnings" not in r2, r4[-400:])
         c5, _, e5 = run("evaluate", f"{W}/vendor.qif", "--manifest", f"{T}/plan/plan.json", "--out", f"{T}/ev-strict", "--strict")
         check("evaluate --strict: refused at that line, nothing written", c5 != 0 and f"vendor.qif:{ext_line}: MeasurementResults: unknown "
               "extension Probe" in e5 and not os.path.exists(f"{T}/ev-strict/errors.csv"), e5)
@@ -175,6 +191,18 @@ if code == 0:
                        "--out", f"{W}/bad-crash", cwd=f"{T}/plan")
     check(f"a DMIS program that moves through the part is refused at its line {first_clear + 2}, nothing written",
           code != 0 and f"crash.dmi:{first_clear + 2}: GOTO to " in err and "the move enters the part at" in err and not os.path.exists(f"{W}/bad-crash"), err)
+    # A program drives the CMM: read strictly by simulate (what read would warn about is refused),
+    # leniently by read.
+    open(f"{T}/plan/late.dmi", "w").write(dmi + "GOTO/0,0,-50\n")
+    code, _, err = run("simulate", "pre_machining.nc", "--machine", f"{SRC}/parts/machines/nmv5000.yaml",
+                       "--part", piece, "--truth", f"{SRC}/examples/truth_thermal_test.yaml", "--cmm-points", "late.dmi",
+                       "--out", f"{W}/bad-late", cwd=f"{T}/plan")
+    check(f"simulate: a program with a move after ENDFIL is refused at its line {len(lines) + 1}, nothing written",
+          code != 0 and f"late.dmi:{len(lines) + 1}: statements after ENDFIL" in err and not os.path.exists(f"{W}/bad-late"), err)
+    code, out, err = run("read", f"{T}/plan/late.dmi", "--json")
+    check("read: the same program read, with the warning at that line",
+          code == 0 and [(w["line"], w["what"]) for w in json.loads(out)["warnings"]] == [(len(lines) + 1, "statements after ENDFIL; passed over")],
+          out[-300:] + err)
     code, out, err = run("read", f"{T}/run/cmm_results.qif", "--json")
     d = json.loads(out) if code == 0 else {}
     cyl = [f for f in d.get("features", []) if f["name"] == "CYL"]
@@ -223,6 +251,25 @@ if code == 0:
         c3, _, e3 = run("evaluate", f"{S}/run-dmis/cmm_results.dmo", *args, "--out", f"{S}/ev-dmis") if code == 0 else (1, "", err)
         check("W8: the CMM runs cmm_plan.dmi (moves checked) and its DMIS output gives the CSV route's errors.csv",
               c3 == 0 and numbers(f"{S}/ev-dmis/errors.csv") == a, e3)
+        if c3 == 0:
+            # A statement after ENDFIL (issue 34): passed over with a warning in stdout, evaluation.json
+            # and report.md; the same errors.csv; --strict refuses it.
+            dmo = open(f"{S}/run-dmis/cmm_results.dmo").read()
+            late = dmo.count("\n") + 1
+            open(f"{W}/late.dmo", "w").write(dmo + "DISPLY/OFF\n")
+            c6, out6, e6 = run("evaluate", f"{W}/late.dmo", *args, "--out", f"{S}/ev-late")
+            ev6 = json.load(open(f"{S}/ev-late/evaluation.json")) if c6 == 0 else {}
+            r6 = open(f"{S}/ev-late/report.md").read() if c6 == 0 else ""
+            what = "statements after ENDFIL; passed over"
+            check(f"W8: a statement after ENDFIL warned at line {late} in stdout, evaluation.json and report.md; the same errors.csv",
+                  c6 == 0 and f"warning: {W}/late.dmo:{late}: {what}" in out6 and numbers(f"{S}/ev-late/errors.csv") == a
+                  and ev6.get("input_warnings") == [{"file": f"{W}/late.dmo", "line": late, "what": what}]
+                  and f"- `{W}/late.dmo` line {late}: {what}" in r6
+                  and "input_warnings" not in json.load(open(f"{S}/ev-dmis/evaluation.json"))
+                  and "Input warnings" not in open(f"{S}/ev-dmis/report.md").read(), (out6[-300:], e6, ev6.get("input_warnings")))
+            c7, _, e7 = run("evaluate", f"{W}/late.dmo", *args, "--out", f"{S}/ev-late-strict", "--strict")
+            check("W8 --strict: refused at that line, nothing written",
+                  c7 != 0 and f"late.dmo:{late}: statements after ENDFIL" in e7 and not os.path.exists(f"{S}/ev-late-strict/errors.csv"), e7)
         ok, e = valid(f"{S}/ev-qif/results.qif")
         check("W8's results.qif (e_pos, e_proc, e_splz per step with u) validates against the QIF 3.0 XSD", ok, e)
         code, out, err = run("read", f"{S}/ev-qif/results.qif", "--json")

@@ -13,7 +13,9 @@ that evaluation.json:
   sqrt(U_points^2 + U_features^2), and the largest difference per error is printed in units of it;
 - a QIF 3.0 Results file with only MeasuredFeatures (one MeasurementResults per cycle, the
   point route's centres): the same errors; the same from points only (25 per sphere, exactly
-  on a sphere about each centre: fitted here); a sphere with neither refused;
+  on a sphere about each centre: fitted here); a sphere with neither refused; with a vendor's
+  extension, the reader's warning in stdout, evaluation.json's input_warnings and report.md
+  (issue 34 item 4), none in the clean file's outputs, and --strict refusing it;
 - refusals with the file and line: an unknown kind, a missing column, two foreign rows on one
   place without time_s, a foreign row far from every sphere; a position without a centre in a
   cycle makes that cycle incomplete, listed as the point route lists it.
@@ -163,6 +165,37 @@ try:
     check("QIF MeasuredFeatures (spheres, no points): the same errors as the point route (to 1e-9)",
           code == 0 and sorted(bq) == sorted(bp) and
           max(abs(bq[c][j]["value"] - bp[c][j]["value"]) for c in bp for j in range(7)) <= 1e-9, err)
+    # A vendor's extension in the file (issue 34 item 4): read with a warning that reaches every
+    # output of the evaluation (stdout, evaluation.json's input_warnings, report.md's section);
+    # the clean file's outputs carry neither; --strict refuses it.
+    clean = open(q).read()
+    at = clean.index("</MeasurementResults>")
+    ext_line = clean[:at].count("\n") + 1
+    v = write("vendor.qif", clean[:at] + '<v:Probe xmlns:v="urn:vendor">T1</v:Probe>' + clean[at:])
+    code, out, err = run("evaluate", v, "--format", "qif", "--manifest", PLAN, "--out", f"{W}/vendor")
+    what = "MeasurementResults: unknown extension Probe"
+    ev_v = json.load(open(f"{W}/vendor/evaluation.json")) if code == 0 else {}
+    iw = ev_v.pop("input_warnings", [])
+    check(f"QIF with a vendor extension: the warning at line {ext_line} in stdout and in evaluation.json's input_warnings",
+          code == 0 and f"warning: {v}:{ext_line}: {what}" in out and len(iw) == 1 and iw[0]["file"] == v
+          and iw[0]["line"] == ext_line and iw[0]["what"].startswith(what), (out[-400:], iw, err))
+    check("the same evaluation otherwise (every key but input_warnings, the file's name aside)",
+          json.dumps(ev_v).replace(v, q) == json.dumps(ev_q), "")
+    rep_v = open(f"{W}/vendor/report.md").read() if code == 0 else ""
+    rep_q = open(f"{W}/qif/report.md").read() if os.path.exists(f"{W}/qif/report.md") else ""
+    check("report.md: an 'Input warnings' section naming the file and line; the clean file's report has none",
+          f"## Input warnings" in rep_v and f"- `{v}` line {ext_line}: {what}" in rep_v and "Input warnings" not in rep_q
+          and "input_warnings" not in ev_q, rep_v[-500:])
+    # ... and the HTML page made from that evaluation.json (probeloop report sphere).
+    c1, _, e1 = run("report", "sphere", "--evaluation", f"{W}/vendor/evaluation.json", "--html", f"{W}/vendor.html")
+    c2, _, e2 = run("report", "sphere", "--evaluation", f"{W}/qif/evaluation.json", "--html", f"{W}/clean.html")
+    page_v = open(f"{W}/vendor.html").read() if c1 == 0 else ""
+    page_q = open(f"{W}/clean.html").read() if c2 == 0 else ""
+    check("report sphere: the page from the warned evaluation has the 'Input warnings' section with the line; the clean one none",
+          f"<h2>Input warnings</h2>" in page_v and f"line {ext_line}: {what}" in page_v and "Input warnings" not in page_q, e1 + e2)
+    code, out, err = run("evaluate", v, "--format", "qif", "--manifest", PLAN, "--out", f"{W}/vendor-strict", "--strict")
+    check("--strict: refused at that line, nothing written", code != 0 and f"{v}:{ext_line}: {what}" in err
+          and not os.path.exists(f"{W}/vendor-strict/evaluation.json"), err)
     q = write("nolocation.qif", qif(ev_p, drop_location=True))
     code, out, err = run("evaluate", q, "--format", "qif", "--manifest", PLAN, "--out", f"{W}/noloc")
     check("refused: a QIF sphere without its measured Location or points, with its line",

@@ -15,6 +15,15 @@ of tests/data/foreign (README.md there has each file's provenance):
   CheckMate's direction within 0.1 mrad; the warnings reach fit's output (text and --json).
 - the DMSC's demoQIFout.py results (features only): read with its four features and their
   diameters (from the file's text), no points, no warning; `fit` refuses it for want of points.
+- the CheckMate file as KBO Systems' QIF_Import writes it back: CheckMate's 691 points set by
+  set, the same two warnings at its own lines, the 12 characteristic values it lost named in a
+  note, and CYL_1's cylinder as from the original;
+- the DMSC's Exploded_Results1.QIF (characteristics only, items in another document): no
+  features, the two values of its text, no warning, the missing FileUnits in a note;
+- Mitutoyo's QIF 2.0.0 results sample: refused at its root's line, naming the namespace;
+- a DMIS output in a CMM package's manner, written here (no public one was found): its 16 bore
+  points read, a re-taken point and the missing ENDFIL warned at their lines, --strict refusing
+  the first, and `fit cylinder --feature CYL` against an independent least-squares cylinder.
 
 Needs $PROBELOOP and $PROBELOOP_SOURCE_DIR."""
 import json, math, os, re, subprocess, sys
@@ -201,4 +210,118 @@ check(f"testPython30: {len(meas)} measured features ({', '.join(meas)}; diameter
       and all(not f["points_mm"] for f in d["features"]) and d["warnings"] == [] and "point_sets" not in d, (got, err))
 rc, out, err = run("fit", "cylinder", PY, "--feature", "DAT_B")
 check("testPython30: fit refuses a file without points", rc != 0 and f"no measured features with points in the file ({len(meas)} features)" in err, err)
+
+# The same CheckMate file as KBO Systems' QIF_Import (a .NET QIF library) writes it back: another
+# producer's serialization (attributes reordered, points tab-indented, E-notation), its mistakes
+# kept, and 12 characteristic values lost (measurements with a status only).
+KB = os.path.join(SRC, "tests", "data", "foreign", "qif", "kbo", "QIF_PTS_SAMPLE.conv.qif")
+kb = open(KB, encoding="utf-8").read()
+kb_lines = kb.split("\n")
+kb_sets = {}
+for m in re.finditer(r"<MeasuredPointSet ([^>]*)>(.*?)</MeasuredPointSet>", kb, re.S):
+    sid = re.search(r'id="(\d+)"', m.group(1)).group(1)
+    nums = [float(x) for x in re.search(r"<Points>(.*?)</Points>", m.group(2), re.S).group(1).split()]
+    kb_sets[sid] = [nums[i:i + 3] for i in range(0, len(nums), 3)]
+check("KBO: the 12 point sets hold CheckMate's 691 points, set by set, every digit (both texts parsed here)",
+      kb_sets == points_by_set, sorted(kb_sets))
+kb_self = next(i + 1 for i, l in enumerate(kb_lines) if "<WholePointSetId>828</WholePointSetId>" in l)
+kb_nolist = next(i + 1 for i, l in enumerate(kb_lines) if '<PointFeatureMeasurement id="776">' in l)
+no_value = [b for b in re.findall(r"<(\w+CharacteristicMeasurement) id=\"\d+\">(.*?)</\1>", kb, re.S) if "<Value>" not in b[1]]
+rc, js, err = run("read", KB, "--json")
+d = json.loads(js) if rc == 0 else {}
+ws = sorted((w["line"], w["what"].split(";")[0]) for w in d.get("warnings", []))
+check(f"KBO: read gives 14 features, 12 sets with 691 points ({assigned} assigned), the two mistakes warned at its own lines "
+      f"{kb_nolist} and {kb_self}",
+      rc == 0 and len(d["features"]) == 14 and d["point_sets"] == {"count": 12, "points": 691}
+      and sum(len(f["points_mm"]) for f in d["features"]) == assigned
+      and [x[0] for x in ws] == sorted([kb_self, kb_nolist]), (ws, err))
+check(f"KBO: the {len(no_value)} characteristic measurements without a Value named in a note, the others read "
+      f"({len(re.findall('<Value>', kb.split('<MeasuredCharacteristics>')[1]))})",
+      rc == 0 and len(no_value) == 12 and any(n.startswith("12 characteristic measurements without a Value") for n in d["notes"])
+      and len(d["characteristics"]) == len(re.findall("<Value>", kb.split("<MeasuredCharacteristics>")[1])), (d.get("notes"), err))
+rc, _, err = run("read", KB, "--strict")
+check(f"KBO --strict: refused at line {min(kb_self, kb_nolist)}", rc != 0 and f"{KB}:{min(kb_self, kb_nolist)}: " in err, err)
+rc, js, err = run("fit", "cylinder", KB, "--feature", "CYL_1", "--json")
+j = json.loads(js) if rc == 0 else {}
+print(f"KBO fit cylinder CYL_1: r = {param(j, 'r_mm')} mm, form {j.get('form_um')} um")
+check(f"KBO: fit cylinder --feature CYL_1 = the independent LS cylinder of CheckMate's points ({r_ls:.6f} mm) within 1e-6 mm",
+      rc == 0 and abs(param(j, "r_mm") - r_ls) < 1e-6 and angle(axis_of(j), d_ls) < 1e-6, err)
+
+# The DMSC's Exploded_Results1.QIF: characteristic measurements only, referring to their items in
+# another document (xId), no features, no FileUnits.
+EX = os.path.join(SRC, "tests", "data", "foreign", "qif", "Exploded_Results1.QIF")
+ex = open(EX, encoding="utf-8").read()
+vals = [(m.group(1), float(m.group(2))) for m in re.finditer(r"<(\w+CharacteristicMeasurement) id=\"\d+\">.*?<Value>([0-9.]+)</Value>", ex, re.S)]
+rc, js, err = run("read", EX, "--json")
+d = json.loads(js) if rc == 0 else {}
+got = [(c["name"], c["value"]) for c in d.get("characteristics", [])]
+print(f"Exploded_Results1: {got}")
+check(f"Exploded_Results1: no features, the {len(vals)} characteristic values of the text ({vals}), no warning, "
+      "the missing FileUnits in a note (mm)",
+      rc == 0 and d["features"] == [] and len(got) == len(vals) == 2 and all(a == b and abs(x - y) < 1e-12 for (a, x), (b, y) in zip(got, vals))
+      and d["warnings"] == [] and d["length_unit"] == "mm" and any("no FileUnits" in n for n in d["notes"]), (got, err))
+rc2, js2, _ = run("read", EX, "--json", "--strict")
+check("Exploded_Results1 --strict: the same (nothing was read leniently)", rc2 == 0 and js2 == js)
+
+# Mitutoyo's QIF 2.0.0 results sample (the QIF community's legacy folder): another version of the
+# standard changes the meaning of every element: refused at the line where its root's start tag
+# ends (libxml2's line of the element), naming the namespace.
+MI = os.path.join(SRC, "tests", "data", "foreign", "qif", "qif2", "mitutoyo_results_serialized_pass_fail_sample.QIF")
+mi = open(MI, encoding="utf-8").read()
+root_end = mi[: mi.index(">", mi.index("<QIFDocument"))].count("\n") + 1
+rc, out, err = run("read", MI)
+check(f"Mitutoyo QIF 2.0.0: refused at line {root_end}, naming the qif2 namespace and what is read",
+      rc == 1 and f"{MI}:{root_end}: QIFDocument: namespace 'http://qifstandards.org/xsd/qif2'" in err and "reads QIF 3" in err, err)
+
+
+# A DMIS output in the manner of a CMM package's (no public one was found, tests/data/foreign/README.md):
+# lower case, blanks, a vendor statement, a continuation, a comment inside a continued statement,
+# tolerances and OUTPUT, one point re-taken (reported twice) and no ENDFIL. A bore of 16 points.
+def bore_points():
+    pts = []
+    for h, z in enumerate((-2.0, -6.0, -10.0, -14.0)):
+        for a in range(4):
+            t = math.radians(90 * a + 22.5 * h)
+            r = 6.0 + 0.002 * ((h * 4 + a) % 5 - 2)  # a form of a few um
+            pts.append([round(10 + r * math.cos(t) + 0.001 * z, 6), round(-5 + r * math.sin(t) - 0.0005 * z, 6), z])
+    return pts
+
+
+bore = bore_points()
+lines_dmo = ["FILNAM/'BORE 12',05.2", "DMESWV/'some vendor 7.1'", "UNITS/MM,ANGDEC", "F(CYL)=FEAT/CYLNDR,INNER,CART,10,-5,0,0,0,1,12"]
+for k, p in enumerate(bore, start=1):
+    if k == 5:  # first taken elsewhere, then re-taken: the later report is the point
+        lines_dmo.append(f"fa(cyl_p05) = feat/point, cart, {p[0] + 0.5}, {p[1]}, {p[2]}, 0, 0, 1")
+        retaken = len(lines_dmo) + 1
+    if k == 9:
+        lines_dmo += [f"FA(CYL_P09)=FEAT/POINT,CART,{p[0]},$", "$$ a comment between the parts", f"{p[1]},{p[2]},0,0,1"]
+    else:
+        lines_dmo.append(f"fa(cyl_p{k:02d}) = feat/point, cart, {p[0]}, {p[1]}, {p[2]}, 0, 0, 1")
+lines_dmo += ["FA(CYL)=FEAT/CYLNDR,INNER,CART,10,-5,0,0,0,1,12.004", "T(DIA)=TOL/DIAM,-0.05,0.05", "TA(DIA)=TOL/DIAM,12.004,INTOL",
+              "OUTPUT/FA(CYL),TA(DIA)"]
+first5 = next(i + 1 for i, l in enumerate(lines_dmo) if l.startswith("fa(cyl_p05)"))
+DMO = os.path.join(os.environ.get("TMPDIR", "/tmp"), f"probeloop-foreign-{os.getpid()}.dmo")
+open(DMO, "w").write("\r\n".join(lines_dmo) + "\r\n")
+rc, js, err = run("read", DMO, "--json")
+d = json.loads(js) if rc == 0 else {}
+ws = [(w["line"], w["what"]) for w in d.get("warnings", [])]
+check(f"DMIS output: 1 feature CYL with the 16 points, warned: the re-taken point at line {retaken}, no ENDFIL at line {len(lines_dmo)}",
+      rc == 0 and [f["name"] for f in d["features"]] == ["CYL"] and len(d["features"][0]["points_mm"]) == 16
+      and ws == [(retaken, f"FA(CYL_P05) reported again (first at line {first5}); the later one read"),
+                 (len(lines_dmo), "no ENDFIL after the last statement (the file may be cut short); what is there was read")], (ws, err))
+check("DMIS output: the points as the text states them (the later P05, P09 joined across its comment)",
+      rc == 0 and all(abs(a - b) < 1e-12 for p, q in zip(d["features"][0]["points_mm"], bore) for a, b in zip(p, q)))
+rc, _, err = run("read", DMO, "--strict")
+check(f"DMIS output --strict: refused at line {retaken}", rc != 0 and f"{DMO}:{retaken}: FA(CYL_P05) reported again" in err, err)
+r_b, d_b, res_b = ls_cylinder(bore)
+rc, js, err = run("fit", "cylinder", DMO, "--feature", "CYL", "--json")
+j = json.loads(js) if rc == 0 else {}
+print(f"DMIS bore: fit r = {param(j, 'r_mm')} mm, independent LS r = {r_b:.7f} mm, form {j.get('form_um')} um")
+check(f"fit cylinder --feature CYL on the DMIS output: r = independent LS {r_b:.7f} mm within 1e-6 mm, axis within 1e-6 rad, "
+      "the two warnings carried",
+      rc == 0 and abs(param(j, "r_mm") - r_b) < 1e-6 and angle(axis_of(j), d_b) < 1e-6 and len(j.get("warnings", [])) >= 2, (j.get("parameters"), err))
+rc, js2, err = run("fit", "cylinder", DMO, "--feature", "cyl", "--json")
+check("fit --feature cyl: DMIS labels are case-insensitive (the same cylinder)",
+      rc == 0 and param(json.loads(js2), "r_mm") == param(j, "r_mm"), err)
+os.remove(DMO)
 check.finish()
