@@ -64,14 +64,15 @@ std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, 
 // True when a CSV text's header holds the feature-actuals columns (for --format auto).
 bool looksLikeFeatureActuals(const std::string& text);
 
+// True when a QIF/DMIS document carries measured features but not one point: the feature route.
+bool holdsOnlyFeatures(const interop::CmmDocument& d);
+
 // The features a CMM file states when it holds no points, for the pieces measured once
 // (thermal test piece, stepped workpiece): a feature-actuals CSV, or a QIF 3.0 Results / DMIS
 // output whose features carry measured geometry and none of them points. nullopt: the file holds
 // points (the point route reads it) or is neither. A QIF with several MeasurementResults is
 // refused (the piece is measured once). warnings: the lenient reader's, "file:line: what"; strict
 // refuses them instead.
-// True when a QIF/DMIS document carries measured features but not one point: the feature route.
-bool holdsOnlyFeatures(const interop::CmmDocument& d);
 struct StatedFeatureFile {
   std::string format;  // features | qif | dmis
   std::vector<FeatureActual> rows;

@@ -27,31 +27,45 @@ double angleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b, bool either_
   return radToDeg(std::acos(std::clamp(c, -1.0, 1.0)));
 }
 
-// The distance that ranks the candidates (mm), and whether the row fits within the rules.
+// The distance that ranks the candidates (mm), whether the row fits within the rules, and the
+// rules it fails.
 struct Fit {
   double distance_mm = std::numeric_limits<double>::infinity();
   double away_mm = std::numeric_limits<double>::infinity();  // from the feature's nominal surface within its extent
-  bool fits = false;
+  std::string why;                                            // the rules it fails, "" when it fits
+  bool fits() const { return why.empty(); }
 };
 
 Fit fitTo(const FeatureActual& r, const parts::NominalFeature& n) {
   Fit f;
+  auto fail = [&](bool bad, const std::string& what, double v, const char* unit, double max) {
+    if (bad) f.why += (f.why.empty() ? "" : ", ") + what + " " + formatSignificant4(v) + " " + unit + " (at most " + formatSignificant4(max) + ")";
+  };
   const Eigen::Vector3d d = r.location_mm - n.point_mm;
   if (n.kind == "plane") {
     const Eigen::Vector3d nn = n.direction.normalized();
     f.distance_mm = std::fabs(d.dot(nn));
     const double out_u = std::max(0.0, std::fabs(d.dot(n.u)) - n.half_u_mm), out_v = std::max(0.0, std::fabs(d.dot(n.v())) - n.half_v_mm);
     f.away_mm = std::sqrt(f.distance_mm * f.distance_mm + out_u * out_u + out_v * out_v);
-    f.fits = angleDeg(r.direction, nn, true) <= kAngleDeg && f.distance_mm <= kNormalMm &&
-             std::fabs(d.dot(n.u)) <= n.half_u_mm + kExtentMarginMm && std::fabs(d.dot(n.v())) <= n.half_v_mm + kExtentMarginMm;
+    const double angle = angleDeg(r.direction, nn, true);
+    fail(angle > kAngleDeg, "normal off by", angle, "deg", kAngleDeg);
+    fail(f.distance_mm > kNormalMm, "off its plane by", f.distance_mm, "mm", kNormalMm);
+    fail(std::max(out_u, out_v) > kExtentMarginMm, "beyond its face by", std::max(out_u, out_v), "mm", kExtentMarginMm);
   } else if (n.kind == "cylinder") {
     const Eigen::Vector3d a = n.direction.normalized();
     f.distance_mm = f.away_mm = (d - d.dot(a) * a).norm();
-    f.fits = angleDeg(r.direction, a, true) <= kAngleDeg && f.distance_mm <= kNormalMm &&
-             (!std::isfinite(r.size_mm) || std::fabs(r.size_mm - 2 * n.radius_mm) <= kDiameterMm);
+    const double angle = angleDeg(r.direction, a, true);
+    fail(angle > kAngleDeg, "axis off by", angle, "deg", kAngleDeg);
+    fail(f.distance_mm > kNormalMm, "off its axis by", f.distance_mm, "mm", kNormalMm);
+    if (std::isfinite(r.size_mm))
+      fail(std::fabs(r.size_mm - 2 * n.radius_mm) > kDiameterMm, "diameter off by", std::fabs(r.size_mm - 2 * n.radius_mm), "mm", kDiameterMm);
   } else if (n.kind == "sphere") {
     f.distance_mm = f.away_mm = d.norm();
-    f.fits = f.distance_mm <= kNormalMm && (!std::isfinite(r.size_mm) || std::fabs(r.size_mm - 2 * n.radius_mm) <= kDiameterMm);
+    fail(f.distance_mm > kNormalMm, "centre off by", f.distance_mm, "mm", kNormalMm);
+    if (std::isfinite(r.size_mm))
+      fail(std::fabs(r.size_mm - 2 * n.radius_mm) > kDiameterMm, "diameter off by", std::fabs(r.size_mm - 2 * n.radius_mm), "mm", kDiameterMm);
+  } else {
+    f.why = "no nominal geometry of kind " + n.kind;
   }
   return f;
 }
@@ -93,6 +107,13 @@ FeatureMatch matchFeatureActuals(const std::vector<FeatureActual>& rows, const p
       if (!compatible(r.kind, f->nominal.kind))
         throw InputError(r.file, r.line, "'" + r.id + "' is a " + f->nominal.kind + " in the plan " + m.file + ", but the file gives a " +
                                              r.kind);
+      // The features routes place the plan's points on the stated feature in the part frame: a
+      // row named for a feature but far from it is a mislabelled row or a file in another frame.
+      const Fit x = fitTo(r, f->nominal);
+      if (!x.fits())
+        throw InputError(r.file, r.line, r.kind + " '" + r.id + "' is named for " + f->nominal.id + " but lies off its nominal geometry: " +
+                                             x.why + ". Mislabelled, or the file is not in the part frame (feature files are read in "
+                                             "the part frame, docs/formats.md#feature-actuals-csv)");
       claim(r, *f, true);
       continue;
     }
@@ -101,12 +122,12 @@ FeatureMatch matchFeatureActuals(const std::vector<FeatureActual>& rows, const p
       double d;
     };
     std::vector<Candidate> fits;
-    UnmatchedFeature nearest{r, "", std::numeric_limits<double>::infinity()};
+    UnmatchedFeature nearest{r, "", std::numeric_limits<double>::infinity(), ""};
     for (const auto& f : m.features) {
       if (!compatible(r.kind, f.nominal.kind)) continue;
       const Fit x = fitTo(r, f.nominal);
-      if (x.fits) fits.push_back({&f, x.away_mm});
-      if (x.away_mm < nearest.distance_mm) nearest.nearest = f.nominal.id, nearest.distance_mm = x.away_mm;
+      if (x.fits()) fits.push_back({&f, x.away_mm});
+      if (x.away_mm < nearest.distance_mm) nearest.nearest = f.nominal.id, nearest.distance_mm = x.away_mm, nearest.why = x.why;
     }
     if (fits.empty()) {
       out.unmatched.push_back(nearest);

@@ -20,8 +20,10 @@
 // frame. Rows of kind point or line, or without measured geometry, are counted, not used.
 //
 // Contract: InputError with the file and line for a row whose id names a feature of another
-// kind (a plane row named CYL), for one feature given twice (both lines), and for rows of more
-// than one measurement run (the piece is measured once: give one run).
+// kind (a plane row named CYL) or whose geometry breaks the rules above against the feature it
+// names (mislabelled, or not in the part frame: the features routes place the plan's points on
+// it), for one feature given twice (both lines), and for rows of more than one measurement run
+// (the piece is measured once: give one run).
 #pragma once
 #include <string>
 #include <vector>
@@ -41,6 +43,7 @@ struct UnmatchedFeature {
   FeatureActual actual;
   std::string nearest;  // the nearest feature of the same kind ("" when the plan has none)
   double distance_mm = 0;  // from its nominal surface within its extent (plane), axis (cylinder), centre (sphere)
+  std::string why;         // the rules it fails against the nearest ("normal off by 2.1 deg (at most 1)", ...)
 };
 
 struct FeatureMatch {

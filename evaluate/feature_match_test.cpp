@@ -100,6 +100,7 @@ TEST(MatchFeatureActuals, ARowThatFitsNothingIsListedWithItsNearestFeature) {
   EXPECT_EQ(r.unmatched[0].actual.id, "B");
   EXPECT_EQ(r.unmatched[0].nearest, "Z1");
   EXPECT_NEAR(r.unmatched[0].distance_mm, 1.5, 1e-12);  // on Z1's plane, 1.5 mm beyond its extent
+  EXPECT_EQ(r.unmatched[0].why, "beyond its face by 1.5 mm (at most 1)");
   EXPECT_EQ(r.unmatched[1].nearest, "");               // the plan has no sphere
   EXPECT_EQ(r.assigned_by, "nominal geometry");
 }
@@ -119,6 +120,13 @@ TEST(MatchFeatureActuals, Refusals) {
   auto two = row(3, "Z2", "plane", {0, 0, -12.1}, {0, 0, 1});
   two.cycle = 2;
   EXPECT_NE(refusal({row(2, "Z1", "plane", {0, -12, -12.1}, {0, 0, 1}), two}).find("f.csv:3: cycle 2: the thermal_test_piece is measured once"),
+            std::string::npos);
+  // A row named for a feature must lie on it too: the features routes place the plan's points
+  // on it in the part frame.
+  const std::string named = refusal({row(5, "Z1", "plane", {0, -12, -12.1}, Eigen::Vector3d(0.035, 0, 1).normalized())});
+  EXPECT_NE(named.find("f.csv:5: plane 'Z1' is named for Z1 but lies off its nominal geometry: normal off by 2.00"), std::string::npos)
+      << named;
+  EXPECT_NE(refusal({row(6, "CYL", "circle", {0.8, 0, -16.5}, {0, 0, 1}, 201.0)}).find("off its axis by 0.8 mm (at most 0.5)"),
             std::string::npos);
   // A normal 2 deg off fits nothing.
   EXPECT_NE(refusal({row(2, "P", "plane", {0, 0, -12.1}, Eigen::Vector3d(0.035, 0, 1).normalized())}).find("nearest"),

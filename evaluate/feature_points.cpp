@@ -3,6 +3,10 @@
 #include <cctype>
 #include <cmath>
 
+#include <algorithm>
+#include <map>
+#include <mutex>
+
 #include "core/csv.hpp"
 #include "core/error.hpp"
 
@@ -32,6 +36,71 @@ double expectedRangeOfNormals(int n) {
   double s = f(a) + f(a + steps * h);
   for (int i = 1; i < steps; ++i) s += (i % 2 ? 4 : 2) * f(a + i * h);
   return s * h / 3;
+}
+
+double rangeStdOfNormals(int n) {
+  if (n < 2) return 0;
+  // A few hundred thousand terms per n: each n once per process.
+  static std::mutex mutex;
+  static std::map<int, double> cache;
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (const auto it = cache.find(n); it != cache.end()) return it->second;
+  // E[R^2] on a grid over [-9, 9]^2 (the integrand vanishes beyond for n < 1e7), the triangle
+  // x < y by the trapezoidal rule (the diagonal, where the integrand is 1 - P^n - (1-P)^n, at
+  // half weight).
+  const int steps = 900;
+  const double a = -9, h = 18.0 / steps;
+  std::vector<double> P(steps + 1), Pn(steps + 1), Qn(steps + 1);
+  for (int i = 0; i <= steps; ++i) {
+    P[i] = normalCdf(a + i * h);
+    Pn[i] = std::pow(P[i], n);
+    Qn[i] = std::pow(1 - P[i], n);
+  }
+  double s = 0;
+  for (int i = 0; i <= steps; ++i) {
+    s += 0.5 * (1 - Pn[i] - Qn[i]);
+    for (int j = i + 1; j <= steps; ++j) s += 1 - Pn[j] - Qn[i] + std::pow(P[j] - P[i], n);
+  }
+  const double er2 = 2 * s * h * h, d2 = expectedRangeOfNormals(n);
+  return cache[n] = std::sqrt(std::max(0.0, er2 - d2 * d2));
+}
+
+double rangeDof(int n) {
+  if (n < 2) return 0;
+  const double r = expectedRangeOfNormals(n) / rangeStdOfNormals(n);
+  return 0.5 * r * r;
+}
+
+double StatedScatter::sigmaFromStatedU_mm() const {
+  if (!u_um) return NAN;
+  const Eigen::Vector3d u = *u_um * 1e-3, a = direction.norm() > 0 ? Eigen::Vector3d(direction.normalized()) : Eigen::Vector3d::Zero();
+  const double n = nAveraging();
+  if (kind == "plane") return a.cwiseProduct(u).norm() * std::sqrt(n);
+  if (kind == "sphere") return std::sqrt(u.squaredNorm() / 3) * std::sqrt(n / 3.0);
+  const double across2 = std::max(0.0, u.squaredNorm() - a.cwiseProduct(u).squaredNorm());
+  return std::sqrt(across2 / 2) * std::sqrt(n / 2.0);
+}
+
+std::string unmatchedText(const UnmatchedFeature& u) {
+  return u.actual.file + ":" + std::to_string(u.actual.line) + ": " + u.actual.kind + " '" + u.actual.id + "' (nearest " +
+         (u.nearest.empty() ? std::string("feature: none of its kind") : u.nearest + ", " + formatSignificant4(u.distance_mm) + " mm") +
+         (u.why.empty() ? "" : ": " + u.why) + ")";
+}
+
+std::vector<std::string> statedScatterNotes(const std::map<std::string, StatedScatter>& s) {
+  std::vector<std::string> out;
+  std::string more, bare;
+  for (const auto& [id, x] : s) {
+    if (x.n_stated > x.n_planned) more += (more.empty() ? "" : ", ") + id + " (" + std::to_string(x.n_stated) + ")";
+    if (!std::isfinite(x.form_um) && !x.u_um) bare += (bare.empty() ? "" : ", ") + id;
+  }
+  if (!more.empty())
+    out.push_back("More points stated than planned for " + more + ": their scatter is not averaged below the planned layout's "
+                  "(scanned points are correlated, and the MPE, mostly systematic, does not average down).");
+  if (!bare.empty())
+    out.push_back("Neither a form nor an uncertainty stated for " + bare + ": the specification alone carries their scatter, and U "
+                  "may be below the point route's (a surface rougher than the MPE is invisible without its form).");
+  return out;
 }
 
 double sigmaFromForm(double form_mm, int n, int p) {
@@ -110,13 +179,17 @@ PointsOnStatedFeatures pointsOnStatedFeatures(const FeatureMatch& match,
     StatedScatter s;
     s.id = n.id;
     s.row = r.id + " (" + r.file + ":" + std::to_string(r.line) + ")";
+    s.kind = r.kind;
+    s.direction = r.direction;
     s.n_stated = r.n_points;
     s.n_planned = k;
     s.form_um = r.form_um;
     const int params = n.kind == "plane" ? 3 : n.kind == "sphere" ? 4 : r.kind == "circle" ? 3 : 5;
-    s.sigma_from_form_mm = sigmaFromForm(r.form_um * 1e-3, r.n_points > 0 ? r.n_points : k, params);
+    s.sigma_from_form_mm = sigmaFromForm(r.form_um * 1e-3, s.nFit(), params);
+    // One range's dof, but never more than the fit's residuals have (n - p).
+    s.form_dof = std::isfinite(s.sigma_from_form_mm) ? std::min(rangeDof(s.nFit()), static_cast<double>(s.nFit() - params)) : 0.0;
     s.u_um = r.u_um;
-    s.point_scale = r.n_points > 0 ? std::sqrt(static_cast<double>(k) / r.n_points) : 1.0;
+    s.point_scale = std::sqrt(static_cast<double>(k) / s.nAveraging());
     out.scatter[n.id] = s;
   }
   return out;

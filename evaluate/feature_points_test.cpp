@@ -21,6 +21,17 @@ TEST(ExpectedRangeOfNormals, MatchesThePublishedControlChartConstants) {
   EXPECT_NEAR(expectedRangeOfNormals(2), 2 / std::sqrt(M_PI), 1e-9);  // exactly 2/sqrt(pi)
 }
 
+TEST(RangeStdOfNormals, MatchesThePublishedControlChartConstants) {
+  // d3 of ASTM E2587 / Montgomery App. VI (3 decimals); d3(2) = sqrt(2 - 4/pi) exactly.
+  const std::pair<int, double> d3[] = {{2, 0.853}, {3, 0.888}, {4, 0.880}, {5, 0.864}, {10, 0.797}, {12, 0.778}, {24, 0.712}};
+  for (const auto& [n, v] : d3) EXPECT_NEAR(rangeStdOfNormals(n), v, 6e-4) << n;
+  EXPECT_NEAR(rangeStdOfNormals(2), std::sqrt(2 - 4 / M_PI), 2e-4);
+  // The dof of one range's sigma: 1/2 (d2/d3)^2, 8.8 for 12 points (not n - 3 = 9, and far
+  // from n - 3 for many points: 85 for 1000, not 997).
+  EXPECT_NEAR(rangeDof(12), 0.5 * std::pow(3.258 / 0.778, 2), 0.05);
+  EXPECT_LT(rangeDof(1000), 120);
+}
+
 TEST(SigmaFromForm, RecoversTheScatterOfLeastSquaresPlaneFitsWithinFivePercent) {
   // 1000 planes of 12 points on a 4 x 3 grid, sigma = 1 um: the mean estimate from the LS form.
   std::mt19937_64 rng(7);
@@ -104,11 +115,14 @@ TEST(PointsOnStatedFeatures, ALeastSquaresFitOfThePlacedPointsReturnsTheStatedFe
   EXPECT_NEAR(std::fabs(fc.element.direction.normalized().dot(axis)), 1.0, 1e-12);
   const Eigen::Vector3d off = fc.element.position_mm - Eigen::Vector3d(0.002, -0.003, -10);
   EXPECT_LT((off - off.dot(axis) * axis).norm(), 1e-9);
-  // The scatter the file states: 48 points for 12 placed, the form over d2(48).
+  // The scatter the file states: 48 points for 12 placed, the form over d2(48); not averaged
+  // below the planned layout (point_scale 1, nAveraging 12).
   const auto& sf = s.scatter.at("F");
   EXPECT_EQ(sf.n_stated, 48);
   EXPECT_EQ(sf.n_planned, 12);
-  EXPECT_DOUBLE_EQ(sf.point_scale, 0.5);
+  EXPECT_EQ(sf.nAveraging(), 12);
+  EXPECT_DOUBLE_EQ(sf.point_scale, 1.0);
+  EXPECT_NEAR(sf.form_dof, 0.5 * std::pow(expectedRangeOfNormals(48) / rangeStdOfNormals(48), 2), 1e-12);  // below 45
   EXPECT_NEAR(sf.sigma_from_form_mm, 1.2e-3 / (expectedRangeOfNormals(48) * std::sqrt(45.0 / 48)), 1e-15);
   EXPECT_EQ(sf.row, "PLN (f.csv:4)");
   EXPECT_TRUE(std::isnan(s.scatter.at("CYL").sigma_from_form_mm));
@@ -131,4 +145,15 @@ TEST(PointsOnStatedFeatures, Refusals) {
             std::string::npos);
   EXPECT_NE(what(row(4, "CYL", "cylinder", {0, 0, -10}, {0, 0, 1}, NAN, NAN, 0), {{"CYL", {{40, 0, -5}}}}).find("f.csv:4: cylinder 'CYL' (CYL) states no diameter"),
             std::string::npos);
+}
+
+TEST(PointsOnStatedFeatures, FewerPointsStatedThanPlannedScaleUpNeverDown) {
+  const auto m = plan();
+  std::map<std::string, std::vector<Eigen::Vector3d>> planned;
+  for (int i = 0; i < 12; ++i) planned["F"].emplace_back(-30 + 6.0 * i, 17.0 * std::sin(i), 0.0);
+  for (int n : {6, 12, 5000}) {
+    const auto s = pointsOnStatedFeatures(matchFeatureActuals({row(2, "F", "plane", {0, 0, 0}, {0, 0, 1}, NAN, NAN, n)}, m), planned,
+                                          "f.csv", "features");
+    EXPECT_DOUBLE_EQ(s.scatter.at("F").point_scale, n < 12 ? std::sqrt(2.0) : 1.0) << n;
+  }
 }

@@ -67,7 +67,7 @@ Contribution contribution(std::string input, char type, std::string dist, std::s
 Contribution statedPlanes(const SwSourceGeometry& g, const std::string& id1, const std::string& id2, double u) {
   double dof = std::numeric_limits<double>::infinity();
   for (const SwPlane* p : {&plane(g, id1), &plane(g, id2)})
-    if (!p->slope_u_from_spec) dof = std::min(dof, static_cast<double>(std::max(1, p->points - 3)));
+    if (!p->slope_u_from_spec) dof = std::min(dof, p->dof());
   return contribution("CMM planes as stated", std::isfinite(dof) ? 'A' : 'B', "normal", g.stated_basis, u, dof);
 }
 
@@ -193,9 +193,9 @@ SwSourceGeometry swGeometryFromPlanes(const parts::PlanManifest& m, std::vector<
     s.u_floor_slope_y_urad = fl.u_slope[1] * 1e6;
     s.u_oz_urad = 0.5 * std::hypot(std::hypot(xp.u_slope[1], xn.u_slope[1]), std::hypot(yp.u_slope[0], yn.u_slope[0])) * 1e6;
     const auto k95 = [](std::initializer_list<const SwPlane*> ps) {
-      int dof = 1 << 20;
+      double dof = 1 << 20;
       for (const auto* q : ps)
-        if (!q->slope_u_from_spec) dof = std::min(dof, std::max(1, q->points - 3));
+        if (!q->slope_u_from_spec) dof = std::min(dof, q->dof());
       return uncertainty::coverageFactor(0.95, dof);
     };
     s.U_lean_x_urad = k95({&xp, &xn}) * s.u_lean_x_urad;
@@ -542,7 +542,8 @@ std::string swEvaluationJson(const SwEvaluation& e) {
     for (const auto& p : g.planes)
       s["planes"].push_back({{"id", p.id}, {"role", p.role}, {"points", p.points},
                              {"point_mm", {p.point_mm.x(), p.point_mm.y(), p.point_mm.z()}},
-                             {"normal", {p.normal.x(), p.normal.y(), p.normal.z()}}, {"residual_s_um", p.rms_um}});
+                             {"normal", {p.normal.x(), p.normal.y(), p.normal.z()}},
+                             {"residual_s_um", p.stated ? nlohmann::ordered_json() : nlohmann::ordered_json(p.rms_um)}});
     for (const auto& t : g.steps)
       s["steps"].push_back({{"step", t.step}, {"size_mm", t.size_mm}, {"width_x_mm", t.width_x_mm}, {"width_y_mm", t.width_y_mm},
                             {"depth_nominal_mm", t.depth_nominal_mm}, {"depth_mm", t.depth_mm},

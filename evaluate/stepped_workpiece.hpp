@@ -55,6 +55,10 @@ struct SwPlane {
   double u_slope[3] = {0, 0, 0};
   double slope_lever[3] = {0, 0, 0};  // sqrt((M^-1)_ii), 1/mm: u_slope per mm of one point's sigma
   bool slope_u_from_spec = false;  // the specification was larger than the residual s
+  // Stated planes (sw_features): the dof of a form-based sigma, rangeDof(n) (0: points - 3).
+  double form_dof = 0;
+  bool stated = false;  // rms_um is then the per-point sigma chosen, not a residual
+  double dof() const { return form_dof > 0 ? form_dof : static_cast<double>(points > 4 ? points - 3 : 1); }
 };
 
 struct SwStepGeometry {

@@ -24,11 +24,6 @@ std::string neededFor(const std::string& id) {
   return "step " + step + "'s width " + (face[0] == 'X' ? "X" : "Y") + ", wall tilt and Oz";
 }
 
-std::string unmatchedText(const UnmatchedFeature& u) {
-  return u.actual.file + ":" + std::to_string(u.actual.line) + ": " + u.actual.kind + " '" + u.actual.id +
-         "' fits no plane of the plan (nearest " + (u.nearest.empty() ? std::string("none") : u.nearest + ", " + formatSignificant4(u.distance_mm) + " mm") +
-         "): not used";
-}
 
 }  // namespace
 
@@ -78,7 +73,7 @@ SwStatedCmm swCmmFromFeatures(const parts::PlanManifest& m, const std::vector<Fe
   for (auto& p : planes) {
     const StatedScatter& sc = placed.scatter.at(p.id);
     const auto* mf = match.find(p.id);
-    const int n = sc.n_stated > 0 ? sc.n_stated : sc.n_planned;
+    const int n = sc.nAveraging();
     // The candidates, per measured point (um): the CMM's specification at the plane's centroid
     // (as the point route's slopes use it), the form's sigma, and a stated u of the location
     // along the normal spread back over the n points it was fitted from.
@@ -93,16 +88,17 @@ SwStatedCmm swCmmFromFeatures(const parts::PlanManifest& m, const std::vector<Fe
     s.sigma_from = "MPE";
     if (std::isfinite(sc.sigma_from_form_mm) && sc.sigma_from_form_mm * 1e3 > s.sigma_um)
       s.sigma_um = sc.sigma_from_form_mm * 1e3, s.sigma_from = "form";
-    if (sc.u_um) {
-      const double u_n = p.normal.cwiseProduct(*sc.u_um).norm() * std::sqrt(static_cast<double>(n));
-      if (u_n > s.sigma_um) s.sigma_um = u_n, s.sigma_from = "stated u";
-    }
+    const double from_u = sc.sigmaFromStatedU_mm() * 1e3;
+    if (std::isfinite(from_u) && from_u > s.sigma_um) s.sigma_um = from_u, s.sigma_from = "stated u";
     p.points = n;
     p.rms_um = s.sigma_um;
     for (int i = 0; i < 3; ++i) p.u_slope[i] = s.sigma_um * sc.point_scale * 1e-3 * p.slope_lever[i];
     p.slope_u_from_spec = s.sigma_from != "form";
+    p.form_dof = s.sigma_from == "form" ? sc.form_dof : 0.0;
+    p.stated = true;
     out.from.planes.push_back(s);
   }
+  out.scatter_notes = statedScatterNotes(placed.scatter);
   out.geometry = swGeometryFromPlanes(m, std::move(planes), file, "cmm");
   out.geometry.stated_basis =
       "from the stated features: per point sigma = the largest of MPE(L)/sqrt 3, form/(d2(n) sqrt((n-3)/n)) and a stated u x "
@@ -129,6 +125,7 @@ SwEvaluation evaluateSteppedWorkpieceFromFeatures(const parts::PlanManifest& m, 
   if (!cmm.from.unmatched.empty())
     e.notes.push_back(std::to_string(cmm.from.unmatched.size()) + " rows of the file fit no plane of the plan and are not used (listed "
                       "in cmm.from_features.unmatched)");
+  for (auto& n : cmm.scatter_notes) e.notes.push_back(std::move(n));
   e.from_features = std::move(cmm.from);
   return e;
 }

@@ -32,7 +32,6 @@
 
 #include "evaluate/feature_actuals.hpp"
 #include "evaluate/stepped_workpiece.hpp"
-#include "interop/cmm_document.hpp"
 
 namespace probeloop::evaluate {
 
@@ -46,7 +45,8 @@ PlannedCmmPoints swPlannedCmmPoints(const parts::PlanManifest& m);
 struct SwStatedCmm {
   SwSourceGeometry geometry;  // route "cmm"
   SwFromFeatures from;
-  std::string criterion_note;  // what the file says of its fitting criterion (fittingCriterionNote)
+  std::string criterion_note;              // what the file says of its fitting criterion (fittingCriterionNote)
+  std::vector<std::string> scatter_notes;  // statedScatterNotes: more points than planned, no form or u
 };
 SwStatedCmm swCmmFromFeatures(const parts::PlanManifest& m, const std::vector<FeatureActual>& rows,
                               const PlannedCmmPoints& planned, const std::string& file, const std::string& format);

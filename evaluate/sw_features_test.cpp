@@ -118,14 +118,18 @@ TEST(SwFeatures, PerPointSigmaIsTheLargestOfMpeFormAndStatedU) {
   // S1_YP: nothing stated: the MPE at its centroid (15, 30.0025, -4.5): L = 33.84 mm.
   EXPECT_EQ(yp.sigma_from, "MPE");
   EXPECT_NEAR(yp.sigma_um, (1.5 + std::sqrt(15.0 * 15 + 30.0025 * 30.0025 + 4.5 * 4.5) / 333) / std::sqrt(3.0), 1e-6);
-  // The width's u: each plane's sigma over sqrt(n): 1.6468 / sqrt 24 and the stated 0.6.
+  // The width's u: each plane's sigma over sqrt(n), n never above the plan's 6 (24 stated: a
+  // scan's points are correlated and the MPE does not average down): 1.6468 / sqrt 6 and the
+  // stated 0.6.
   const auto& st = c.geometry.steps[0];
-  EXPECT_NEAR(st.u_wall_x_um, std::hypot(xp.sigma_um / std::sqrt(24.0), 0.6), 1e-6);
+  EXPECT_NEAR(st.u_wall_x_um, std::hypot(xp.sigma_um / std::sqrt(6.0), 0.6), 1e-6);
   // The wall tilt's u: the planned layout (z at zc +- 3 mm, twice each of 3 places: M_zz = 54
-  // mm^2), sigma scaled by sqrt(n_planned / n_stated) = 1/2 for S1_XP, 1 for S1_XN.
-  EXPECT_NEAR(st.u_lean_x_urad, 0.5 * std::hypot(xp.sigma_um * 0.5, xn.sigma_um) * 1e-3 / std::sqrt(54.0) * 1e6, 1e-6);
-  // The form's sigma carries n - 3 dof (21: k = 2.08 at 95 %), the stated u and the MPE none.
-  EXPECT_NEAR(st.U_lean_x_urad / st.u_lean_x_urad, 2.080, 2e-3);
+  // mm^2), sigma scaled by sqrt(n_planned / min(n_stated, n_planned)) = 1 for both.
+  EXPECT_NEAR(st.u_lean_x_urad, 0.5 * std::hypot(xp.sigma_um, xn.sigma_um) * 1e-3 / std::sqrt(54.0) * 1e6, 1e-6);
+  // The form's sigma carries the dof of a range of 24: 1/2 (d2/d3)^2 = 1/2 (3.895/0.712)^2 =
+  // 14.96 (ASTM E2587's d2, d3; below the fit's 21): k = t(0.975, 14.96) = 2.131; the stated u
+  // and the MPE none.
+  EXPECT_NEAR(st.U_lean_x_urad / st.u_lean_x_urad, 2.131, 2e-3);
   EXPECT_NE(c.geometry.stated_basis.find("from the stated features"), std::string::npos);
 }
 
@@ -135,7 +139,7 @@ TEST(SwFeatures, AMissingPlaneIsRefusedAndAForeignRowThatFitsNothingIsListed) {
   rows.push_back(plane(40, "DATUM_B", {15, 15, 50}, {0, 0, 1}));  // 50 mm above the top
   const auto c = swCmmFromFeatures(m, rows, planned(m), "f.csv", "features");
   ASSERT_EQ(c.from.unmatched.size(), 1u);
-  EXPECT_NE(c.from.unmatched[0].find("f.csv:40: plane 'DATUM_B' fits no plane of the plan (nearest TOP, 50 mm)"), std::string::npos)
+  EXPECT_NE(c.from.unmatched[0].find("f.csv:40: plane 'DATUM_B' (nearest TOP, 50 mm: off its plane by 50 mm (at most 0.5))"), std::string::npos)
       << c.from.unmatched[0];
   rows.erase(rows.begin() + 10);  // S2_F
   try {

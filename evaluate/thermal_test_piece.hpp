@@ -144,12 +144,13 @@ struct TtpStatedFeature {
   int line = 0, n_stated = 0, n_planned = 0;  // n_stated 0: not stated
   std::optional<double> form_um;              // as stated
   double sigma_um = 0;                        // per placed point in the budget (RMS over them)
-  std::string sigma_from;                     // specification | stated form | stated u
+  std::string sigma_from;                     // specification | stated forms | stated u
 };
 struct TtpStatedFeatures {
-  std::vector<TtpStatedFeature> features;  // datums first, then the manifest's order
-  std::vector<std::string> unmatched;      // rows not used: "file:line: kind 'id' (nearest X, d mm)"
+  std::vector<TtpStatedFeature> features;  // in the manifest's order
+  std::vector<std::string> unmatched;      // rows not used: "file:line: kind 'id' (nearest X, d mm: why)"
   int other_kinds = 0;                     // point or line rows, not used
+  int points_placed = 0;                   // the plan's points placed on them (TtpEvaluation::points is 0: none read)
 };
 
 struct TtpEvaluation {
@@ -173,9 +174,12 @@ TtpEvaluation evaluateThermalTestPiece(const parts::PlanManifest& m, const TtpPo
 // From the features a CMM states (feature CSV, QIF MeasuredFeatures or DMIS FA actuals without
 // points; evaluate/feature_match.hpp, evaluate/feature_points.hpp): the plan's points placed on
 // each stated feature, then the CMM route's steps, so every value equals the point route's from
-// the same least-squares features; the budget's point scatter per feature is the larger of the
-// CMM's MPE(L)/2 and the stated form over d2(n) (times sqrt(n_planned / n_stated)), or a stated u
-// of the location where larger; no type A (no residuals); e.notes says what is lost.
+// the same least-squares features. The point scatter: the stated forms of the Z paths and facets
+// turned into sigmas (form over d2(n) sqrt((n-3)/n)) and pooled as the point route pools its
+// residuals (type A, sum of rangeDof(n); in e.scatter's type A fields), used where larger than
+// MPE(L)/2; per feature the sigma a stated u of its location implies where larger; all times the
+// feature's point_scale (never below the planned layout's). e.stated lists each feature; e.notes
+// says what is lost; e.points is 0 (none read).
 TtpEvaluation evaluateThermalTestPieceFromFeatures(const parts::PlanManifest& m, const std::vector<FeatureActual>& rows,
                                                    const std::string& file, const std::string& format,
                                                    const TtpOptions& options = {});

@@ -217,19 +217,19 @@ std::vector<TtpCycleResult> cycleValues(const parts::PlanManifest& m, const std:
 // The features route (ttp_features.cpp): per manifest feature, what the file states about the
 // scatter of its points (evaluate/feature_points.hpp). NaN: not stated.
 struct StatedSigma {
-  double scale = 1.0;    // sqrt(n_planned / n_stated): a placed point stands for several measured ones
+  double scale = 1.0;    // StatedScatter::point_scale (>= 1): a placed point stands for that many measured ones
   double form_mm = NAN;  // the form-based sigma of one measured point (sigmaFromForm)
-  double dof = 0;        // its degrees of freedom, n - 3 (0: no form)
-  double u_mm = NAN;     // from a stated u of the location: the sigma per placed point that gives it
+  double dof = 0;        // its degrees of freedom, rangeDof(n) (0: no form)
+  double u_mm = NAN;     // the sigma per measured point a stated u of the location implies
 };
 using StatedSigmas = std::map<std::string, StatedSigma>;
 // The stated forms of the Z paths and facets pooled as the point route pools their residuals:
 // s^2 = sum(nu_f s_f^2) / sum(nu_f), in TtpScatter's type A fields; used when larger than the
 // specification (type_a_used).
 TtpScatter statedScatter(const parts::PlanManifest& m, const StatedSigmas& s, double type_b_sigma_mm);
-// sigma per placed point: the pooled form-based s (when used) or the point's specification,
-// times the feature's scale, or the sigma its stated u implies where larger; and which it was
-// ("specification", "stated forms", "stated u").
+// sigma per placed point: the larger of the pooled form-based s (when used) or the point's
+// specification, and the sigma the feature's stated u implies, per measured point, times the
+// feature's scale; and which it was ("specification", "stated forms", "stated u").
 std::pair<double, const char*> statedPointSigma(double spec_mm, const StatedSigma& s, const TtpScatter& pooled);
 
 // The CMM and on-machine routes; predicted: from the planned points (type B scatter only, the

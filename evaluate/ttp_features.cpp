@@ -34,10 +34,9 @@ TtpScatter statedScatter(const parts::PlanManifest& m, const StatedSigmas& s, do
 }
 
 std::pair<double, const char*> statedPointSigma(double spec_mm, const StatedSigma& s, const TtpScatter& pooled) {
-  std::pair<double, const char*> r{(pooled.type_a_used ? pooled.type_a_sigma_mm : spec_mm) * s.scale,
-                                   pooled.type_a_used ? "stated forms" : "specification"};
+  std::pair<double, const char*> r{pooled.type_a_used ? pooled.type_a_sigma_mm : spec_mm, pooled.type_a_used ? "stated forms" : "specification"};
   if (std::isfinite(s.u_mm) && s.u_mm > r.first) r = {s.u_mm, "stated u"};
-  return r;
+  return {r.first * s.scale, r.second};
 }
 
 std::map<std::string, std::vector<Vector3d>> plannedSurfacePoints(const parts::PlanManifest& m) {
@@ -48,21 +47,6 @@ std::map<std::string, std::vector<Vector3d>> plannedSurfacePoints(const parts::P
 }
 
 }  // namespace ttp
-
-namespace {
-
-// The sigma per placed point a stated standard uncertainty of the location implies: a plane's
-// offset along its normal is sigma / sqrt(n); a circle's or cylinder's centre across its axis
-// sigma sqrt(2 / n) per coordinate (least squares on n points evenly around).
-double sigmaFromStatedU(const FeatureActual& r, int n_planned) {
-  if (!r.u_um) return NAN;
-  const Eigen::Vector3d u = *r.u_um * 1e-3, a = r.direction.normalized();
-  if (r.kind == "plane") return a.cwiseProduct(u).norm() * std::sqrt(static_cast<double>(n_planned));
-  const double across2 = std::max(0.0, u.squaredNorm() - a.cwiseProduct(u).squaredNorm());
-  return std::sqrt(across2 / 2) * std::sqrt(n_planned / 2.0);
-}
-
-}  // namespace
 
 TtpEvaluation evaluateThermalTestPieceFromFeatures(const parts::PlanManifest& m, const std::vector<FeatureActual>& rows,
                                                    const std::string& file, const std::string& format, const TtpOptions& options) {
@@ -77,9 +61,7 @@ TtpEvaluation evaluateThermalTestPieceFromFeatures(const parts::PlanManifest& m,
   ttp::StatedSigmas sigmas;
   for (const auto& mf : match.matched) {
     const auto& s = placed.scatter.at(mf.feature->nominal.id);
-    const bool form = std::isfinite(s.sigma_from_form_mm);
-    sigmas[s.id] = {s.point_scale, s.sigma_from_form_mm, form ? static_cast<double>((s.n_stated ? s.n_stated : s.n_planned) - 3) : 0.0,
-                    sigmaFromStatedU(mf.actual, s.n_planned)};
+    sigmas[s.id] = {s.point_scale, s.sigma_from_form_mm, s.form_dof, s.sigmaFromStatedU_mm()};
   }
   TtpOptions o = options;
   o.form_mz = false;  // the placed points lie on the stated features: their form is the file's
@@ -103,21 +85,17 @@ TtpEvaluation evaluateThermalTestPieceFromFeatures(const parts::PlanManifest& m,
     if (std::isfinite(s.form_um)) f.form_um = s.form_um;
     st.features.push_back(f);
   }
-  for (const auto& u : match.unmatched)
-    st.unmatched.push_back(u.actual.file + ":" + std::to_string(u.actual.line) + ": " + u.actual.kind + " '" + u.actual.id + "' (nearest " +
-                           (u.nearest.empty() ? std::string("feature: none of its kind") : u.nearest + ", " + formatSignificant4(u.distance_mm) + " mm") +
-                           ")");
+  for (const auto& u : match.unmatched) st.unmatched.push_back(unmatchedText(u));
   st.other_kinds = match.other_kinds;
-  // The datums' form as stated (the placed points have none of their own).
+  // The forms as stated, NaN (null, "-") where not; no residuals (the placed points have none).
   if (e.alignment)
     for (auto& d : e.alignment->datums) {
       const auto it = placed.scatter.find(d.id);
-      d.form_um = it != placed.scatter.end() && std::isfinite(it->second.form_um) ? it->second.form_um : 0.0;
+      d.form_um = it != placed.scatter.end() ? it->second.form_um : NAN;
     }
   for (auto& f : e.features) {
-    const auto& s = placed.scatter.at(f.id);
-    f.form_mz_um = std::isfinite(s.form_um) ? s.form_um : 0.0;
-    f.rms_um = 0;
+    f.form_mz_um = placed.scatter.at(f.id).form_um;
+    f.rms_um = NAN;
   }
 
   int not_stated = 0;
@@ -136,6 +114,10 @@ TtpEvaluation evaluateThermalTestPieceFromFeatures(const parts::PlanManifest& m,
   if (!st.unmatched.empty())
     e.notes.push_back(std::to_string(st.unmatched.size()) + " feature" + (st.unmatched.size() == 1 ? "" : "s") +
                       " of the file fit no feature of the plan and are not used (stated_features.unmatched).");
+  for (auto& n : statedScatterNotes(placed.scatter)) e.notes.push_back(std::move(n));
+  // No point was read: the placed ones are the plan's.
+  st.points_placed = e.points;
+  e.points = 0;
   return e;
 }
 

@@ -142,6 +142,7 @@ std::string ttpEvaluationJson(const TtpEvaluation& e) {
     j["stated_features"] = {{"features", st},
                             {"unmatched", e.stated->unmatched},
                             {"rows_of_other_kinds_not_used", e.stated->other_kinds},
+                            {"points_placed", e.stated->points_placed},
                             {"notes", e.notes}};
   }
   j["features"] = ordered_json::array();
@@ -208,9 +209,13 @@ std::string ttpReport(const TtpEvaluation& e) {
   std::ostringstream o;
   const auto cols = columns(e);
   o << "# Thermal test piece (seed 004 Ch. 7): errors and uncertainty budgets\n\n";
-  o << "Manifest `" << e.manifest_file << "`, input `" << e.input_file << "`: " << routeWords(e) << ", " << e.points
-    << (e.route == TtpRoute::Gauge ? " readings" : " points") << ", assigned to features by " << e.assigned_by
-    << ". Every value is relative to the reference cut (cycle 0); U is the expanded uncertainty (k = " << formatNumber(e.coverage_k)
+  o << "Manifest `" << e.manifest_file << "`, input `" << e.input_file << "`: " << routeWords(e) << ", ";
+  if (e.stated)
+    o << e.stated->features.size() << " features, matched by " << e.assigned_by << " (no points: the plan's " << e.stated->points_placed
+      << " placed on them)";
+  else
+    o << e.points << (e.route == TtpRoute::Gauge ? " readings" : " points") << ", assigned to features by " << e.assigned_by;
+  o << ". Every value is relative to the reference cut (cycle 0); U is the expanded uncertainty (k = " << formatNumber(e.coverage_k)
     << "). Definitions, formulas and budget terms: docs/thermal-test-piece-evaluation.md.\n\n";
   for (const auto& n : e.notes) o << "- " << n << "\n";
   if (!e.notes.empty()) o << "\n";
@@ -231,7 +236,8 @@ std::string ttpReport(const TtpEvaluation& e) {
     o << "| file -> part translation (um) | " << formatNumber(a.translation_um.x(), 3) << " | " << formatNumber(a.translation_um.y(), 3)
       << " | " << formatNumber(a.translation_um.z(), 3) << " |\n\n";
     o << "| datum | points | form (um) |\n|---|---|---|\n";
-    for (const auto& d : a.datums) o << "| " << d.id << " | " << d.points << " | " << formatNumber(d.form_um, 3) << " |\n";
+    for (const auto& d : a.datums)
+      o << "| " << d.id << " | " << d.points << " | " << (std::isfinite(d.form_um) ? formatNumber(d.form_um, 3) : "-") << " |\n";
     o << "\n";
   }
   if (e.stated) {
@@ -256,7 +262,7 @@ std::string ttpReport(const TtpEvaluation& e) {
          "|---|---|---|---|---|---|---|---|---|\n";
     for (const auto& f : e.features)
       o << "| " << f.id << " | " << f.cycle << " | " << f.points << " | " << (e.stated ? "-" : formatNumber(f.rms_um, 3)) << " | "
-        << formatNumber(f.form_mz_um, 3)
+        << (std::isfinite(f.form_mz_um) ? formatNumber(f.form_mz_um, 3) : "-")
         << " | " << (f.d_mm ? formatNumber(*f.d_mm, 5) : "") << " | " << (f.depth_mm ? formatNumber(*f.depth_mm, 5) : "") << " | "
         << (f.beta_urad ? formatNumber(*f.beta_urad, 2) : "") << " | " << formatNumber(f.u_d_um, 3) << " |\n";
     o << "\n";
@@ -376,8 +382,8 @@ std::string ttpStdout(const TtpEvaluation& e, const std::string& errors_file, co
   const auto cols = columns(e);
   o << "Thermal test piece (seed 004 Ch. 7), " << routeWords(e) << ": " << e.input_file << ", ";
   if (e.stated)
-    o << e.stated->features.size() << " features matched by " << e.assigned_by << " (no points: the plan's " << e.points
-      << " points placed on them)";
+    o << e.stated->features.size() << " features matched by " << e.assigned_by << " (no points: the plan's "
+      << e.stated->points_placed << " points placed on them)";
   else
     o << e.points << (e.route == TtpRoute::Gauge ? " readings" : " points") << (e.route == TtpRoute::Gauge ? "" : " assigned by " + e.assigned_by);
   o << "\nErrors relative to the reference cut (cycle 0); U for k = " << formatNumber(e.coverage_k) << "\n";

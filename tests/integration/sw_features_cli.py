@@ -87,13 +87,15 @@ def ratios(ev_f, ev_p):
     return r, (min(u), max(u))
 
 
-def agrees(label, ev_f, ev_p):
+def agrees(label, ev_f, ev_p, u_floor=None):
     r, (lo, hi) = ratios(ev_f, ev_p)
     print(f"     {label}: largest |features - points| / sqrt(U_points^2 + U_features^2) over the 4 steps:")
     print("       " + ", ".join(f"{q} {v:.3f}" for q, v in r.items()))
     print(f"       U_features / U_points from {lo:.3f} to {hi:.3f}")
     check(f"{label}: every value within the combined U of the point route's (largest ratio {max(r.values()):.3f})",
           all(v <= 1 for v in r.values()), r)
+    if u_floor is not None:
+        check(f"{label}: with the forms stated, no U below {u_floor} of the point route's", lo >= u_floor, lo)
 
 
 try:
@@ -121,7 +123,7 @@ try:
     check("(a) evaluate reads the QIF's stated planes (auto: a QIF without points)", code == 0 and
           out.startswith(f"CMM planes from the stated features of {qa} (no points; 21 planes matched by labels"), out + err)
     ev_a = json.load(open(f"{W}/qif/evaluation.json")) if code == 0 else ev_p
-    agrees("(a) QIF MeasuredFeatures", ev_a, ev_p)
+    agrees("(a) QIF MeasuredFeatures", ev_a, ev_p, u_floor=0.95)
     ff = ev_a["cmm"].get("from_features", {})
     check("(a) evaluation.json: each plane's row, how it was matched, its form and the sigma used",
           ff.get("format") == "qif" and len(ff.get("planes", [])) == 21 and
@@ -160,16 +162,16 @@ try:
     code, out, err = evaluate(csv, "csv")
     check("(b) the feature CSV (auto-detected): 21 planes matched by nominal geometry, the alignment row listed",
           code == 0 and "21 planes matched by nominal geometry, 1 row fits no plane" in out and
-          f"{csv}:23: plane 'ALIGN_Z' fits no plane of the plan (nearest TOP, 40 mm): not used" in out, out + err)
+          f"{csv}:23: plane 'ALIGN_Z' (nearest TOP, 40 mm: off its plane by 40 mm (at most 0.5))" in out, out + err)
     ev_b = json.load(open(f"{W}/csv/evaluation.json")) if code == 0 else ev_p
-    agrees("(b) feature CSV, foreign ids", ev_b, ev_p)
+    agrees("(b) feature CSV, foreign ids", ev_b, ev_p, u_floor=0.95)
     fb = ev_b["cmm"].get("from_features", {})
     by_id = {p["id"]: p for p in fb.get("planes", [])}
     first = rows[0][0]
     check("(b) the first shuffled row is the plane it was written from, with the file's n and line",
           by_id.get(first, {}).get("row") == f"Plane 1 ({csv}:2)" and by_id[first]["n_stated"] == rows[0][4] and
           by_id[first]["matched_by"] == "nominal geometry" and fb["unmatched"] == [
-              f"{csv}:23: plane 'ALIGN_Z' fits no plane of the plan (nearest TOP, 40 mm): not used"], fb)
+              f"{csv}:23: plane 'ALIGN_Z' (nearest TOP, 40 mm: off its plane by 40 mm (at most 0.5))"], fb)
     code2, _, _ = evaluate(csv, "csv2")
     same = code2 == 0 and all(open(f"{W}/csv/{f}", "rb").read() == open(f"{W}/csv2/{f}", "rb").read()
                               for f in ("errors.csv", "evaluation.json", "report.md", "compensation.json", "results.qif"))
@@ -192,6 +194,9 @@ try:
           out + err)
     ev_c = json.load(open(f"{W}/dmis/evaluation.json")) if code == 0 else ev_p
     agrees("(c) DMIS FA actuals", ev_c, ev_p)
+    check("(c) no form stated: the notes say U may be below the point route's",
+          any(n.startswith("Neither a form nor an uncertainty stated for") and "may be below the point route's" in n
+              for n in ev_c["notes"]), ev_c["notes"])
     check("(c) DMIS states no form: every plane's sigma is the MPE's, the e_pos terms type B (no dof)",
           all(p["sigma_from"] == "MPE" and p["form_um"] is None for p in ev_c["cmm"]["from_features"]["planes"]) and
           all(c["type"] == "B" and c["dof"] is None for s in ev_c["separation"] for q in ("e_pos_x_um", "e_pos_z_um")

@@ -70,6 +70,12 @@ def compare(name, ev_p, ev_f, exact=None):
         check(f"{name}: the same values as the point route to the file's rounding ({d:.4f} <= {exact})", d <= exact, worst)
 
 
+def u_ratios(ev_p, ev_f):
+    """U_features / U_points over every value of the measurement cycles."""
+    vp, vf = values(ev_p), values(ev_f)
+    return [vf[k][1] / vp[k][1] for k in vp if k[0] > 0 and k in vf and vp[k][1] > 0]
+
+
 def strip_qif_points(text):
     text = re.sub(r'\s*<PointList n="\d+">\s*<WholePointSetId>\d+</WholePointSetId>\s*</PointList>', "", text)
     return re.sub(r'\s*<MeasuredPointSets n="\d+">.*?</MeasuredPointSets>', "", text, flags=re.S)
@@ -146,6 +152,10 @@ try:
           "the features a CMM states (qif)" in out and "49 features matched by labels" in out, out + err)
     ev_q = json.load(open(f"{W}/qif/evaluation.json"))
     compare("QIF MeasuredFeatures", ev_p, ev_q, exact=0.002)
+    r = u_ratios(ev_p, ev_q)
+    print(f"     U_features / U_points: {min(r):.3f} to {max(r):.3f}")
+    check("the stated forms' U is the point route's within -5 % / +30 % (the forms pooled: a range-based estimate of the "
+          "same scatter)", 0.95 <= min(r) and max(r) <= 1.3, (min(r), max(r)))
     st = ev_q["stated_features"]
     check("evaluation.json states each feature, its form and the sigma used, and what is lost",
           len(st["features"]) == 49 and all(f["form_um"] > 0 and f["point_sigma_um"] > 0 for f in st["features"]) and
@@ -185,6 +195,16 @@ try:
     check("the sphere the plan does not have is listed as not used, the point row counted",
           len(st["unmatched"]) == 1 and "sphere 'REF_SPHERE' (nearest feature: none of its kind)" in st["unmatched"][0] and
           f"{W}/features.csv:2" in st["unmatched"][0] and st["rows_of_other_kinds_not_used"] == 1, st["unmatched"])
+    # Ten times the planned points stated for every feature (a scanning CMM): U not below the
+    # planned layout's (the counts only change the form's d2(n)).
+    many = [rows[0]] + [",".join(r.split(",")[:11] + [str(10 * int(r.split(",")[11]))] + r.split(",")[12:]) for r in rows[1:]]
+    open(f"{W}/many.csv", "w").write("\n".join(many) + "\n")
+    code, out, err = run("evaluate", f"{W}/many.csv", "--manifest", PLAN, "--out", f"{W}/many")
+    ev_m = json.load(open(f"{W}/many/evaluation.json")) if code == 0 else {"cycles": []}
+    r = u_ratios(ev_p, ev_m)
+    check("ten times the planned points stated: U stays at least 0.95 of the point route's, and a note says why",
+          code == 0 and min(r) >= 0.95 and any(n.startswith("More points stated than planned") for n in ev_m["stated_features"]["notes"]),
+          (min(r) if r else None, err))
     check("each feature names its row and the counts the file states",
           all(f["matched_by"] == "nominal geometry" and f["n_points_stated"] == counts[f["id"]] for f in st["features"]))
     check("the criterion the rows state: 48 least squares, the one Chebyshev facet named",
@@ -203,6 +223,11 @@ try:
     compare("DMIS FA actuals", ev_p, ev_d, exact=0.002)
     check("DMIS FA states no criterion: taken as least squares, said so",
           any(n.startswith("The file does not say how its features were fitted") for n in ev_d["stated_features"]["notes"]))
+    check("no form in DMIS FA: the notes say U may be below the point route's",
+          any(n.startswith("Neither a form nor an uncertainty stated for") and "may be below the point route's" in n
+              for n in ev_d["stated_features"]["notes"]))
+    r = u_ratios(ev_p, ev_d)
+    print(f"     DMIS: U_features / U_points: {min(r):.3f} to {max(r):.3f}")
     check("no form in DMIS FA: every feature's scatter is the specification",
           all(f["point_sigma_from"] == "specification" and f["form_um"] is None for f in ev_d["stated_features"]["features"]))
 
