@@ -99,8 +99,12 @@ FeatureMatch matchFeatureActuals(const std::vector<FeatureActual>& rows, const p
     (by_id ? any_label : any_geometry) = true;
   };
   for (const auto& r : rows) {
-    if (r.kind == "point" || r.kind == "line" || r.kind == "other" || !r.has_geometry) {
+    if (r.kind == "point" || r.kind == "line" || r.kind == "other") {
       ++out.other_kinds;
+      continue;
+    }
+    if (!r.has_geometry) {  // a QIF/DMIS feature with neither points nor measured geometry
+      out.unmatched.push_back({r, "", 0, "states no measured geometry"});
       continue;
     }
     if (const auto* f = m.feature(r.id)) {

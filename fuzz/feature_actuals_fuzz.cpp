@@ -1,7 +1,7 @@
 // Feature actuals (the CSV a CMM report turns into, docs/formats.md#feature-actuals-csv) against
 // both plans that read them: the sphere artifact's centres, and the thermal test piece's
 // features route (matched by id or nominal geometry, the plan's points placed on them, the
-// whole evaluation).
+// whole evaluation); and the same bytes as a QIF or DMIS file of features only.
 #include <cstddef>
 #include <cstdint>
 
@@ -18,8 +18,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const auto& m = fuzz::sphereManifest();
     evaluate::sphereCentresFromFeatures(evaluate::parseFeatureActuals(text, "features.csv", m.cycles), m);
   });
-  return fuzz::expectRefusalOrSuccess([&] {
+  fuzz::expectRefusalOrSuccess([&] {
     evaluate::evaluateThermalTestPieceFromFeatures(fuzz::ttpManifest(), evaluate::parseFeatureActuals(text, "features.csv"),
                                                    "features.csv", "features");
+  });
+  // The same bytes as a QIF or DMIS file of features only (readStatedFeatures decides).
+  return fuzz::expectRefusalOrSuccess([&] {
+    if (const auto s = evaluate::readStatedFeatures("features.qif", text, false))
+      evaluate::evaluateThermalTestPieceFromFeatures(fuzz::ttpManifest(), s->rows, "features.qif", s->format);
   });
 }

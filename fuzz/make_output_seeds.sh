@@ -54,5 +54,9 @@ seed ttp_on_machine out_dprnt.txt "$W/ttp-run/dprnt.txt" 150
 seed qif out_cmm_results.qif "$W/ttp-run/cmm_results.qif"
 seed dmis out_cmm_results.dmo "$W/ttp-run/cmm_results.dmo"
 seed ttp_cmm_csv out_cmm_export.csv "$W/ttp-run/cmm_export.csv" 150
+# The CMM's results without their points (the features routes, issue 34): QIF and DMIS.
+sed -E -e '/<PointList n="[0-9]+">/,/<\/PointList>/d' -e '/<MeasuredPointSets /,/<\/MeasuredPointSets>/d' \
+  "$W/ttp-run/cmm_results.qif" > "$W/ttp-run/features.qif"
+seed feature_actuals out_features.qif "$W/ttp-run/features.qif"
 ls "$W/ttp-run" "$W/run"
 echo "make_output_seeds: done"
