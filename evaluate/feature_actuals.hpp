@@ -9,10 +9,12 @@
 // cylinder, plane or point; x/y/z the centre (sphere, circle), a point on the axis (cylinder)
 // or on the plane; i/j/k the axis or normal (empty or 0 for a sphere or point); size_mm the
 // diameter (empty for a plane or point); form_um the form deviation (empty: not stated);
-// n_points the number of points the CMM fitted (>= 1).
+// n_points the number of points the CMM fitted: at least the element's fitted parameters
+// (minimumPoints: plane 3, circle 3, sphere 4, cylinder 5, point 1).
 //
 // Contract: InputError with file:line:field for a missing column, an unknown kind, a field that
-// is not a number where one is needed, a count that is not a positive integer, a negative
+// is not a number where one is needed, a count that is not a positive integer or is below the
+// kind's minimumPoints (no fit of that kind has so few points), a negative
 // size/form/u, a direction of zero length where one is needed, a coordinate or size beyond 1 km
 // or a form or u beyond 1 m (not a measurement: it would overflow a budget). Nothing is guessed
 // silently.
@@ -47,6 +49,10 @@ struct FeatureActual {
   // e.g. LEASTSQUARES, MINMAX; the CSV's optional column `algorithm`); "" not stated.
   std::string algorithm;
 };
+
+// The fewest points that fix an element of the kind (its least-squares fit's parameters):
+// plane 3, circle 3, sphere 4, cylinder 5; point (and any other) 1.
+int minimumPoints(const std::string& kind);
 
 // max_cycle > 0 refuses a cycle beyond it (the plan's cycles).
 std::vector<FeatureActual> parseFeatureActuals(const std::string& text, const std::string& file, int max_cycle = 0);

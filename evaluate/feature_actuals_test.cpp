@@ -88,6 +88,28 @@ TEST(FeatureActuals, RefusesWithLineAndField) {
             std::string::npos);
 }
 
+// A fit needs at least as many points as its element has parameters: plane 3 (distance, two
+// angles of the normal), circle 3 (centre in its plane, radius), sphere 4 (centre, radius),
+// cylinder 5 (axis: a point in a plane across it and two angles; radius). One fewer is refused
+// with the line and the field; exactly that many is read; a point is one point.
+TEST(FeatureActuals, RefusesFewerPointsThanTheElementsParameters) {
+  const std::string h = "cycle,id,kind,x_mm,y_mm,z_mm,i,j,k,size_mm,form_um,n_points\n";
+  const std::pair<const char*, int> kinds[] = {{"1,A,plane,0,0,0,0,0,1,,,", 3},
+                                               {"1,A,circle,0,0,0,0,0,1,20,,", 3},
+                                               {"1,A,sphere,0,0,0,,,,30,,", 4},
+                                               {"1,A,cylinder,0,0,0,0,0,1,20,,", 5},
+                                               {"1,A,point,0,0,0,,,,,,", 1}};
+  for (const auto& [r, minimum] : kinds) {
+    for (int n = 1; n < minimum; ++n)
+      EXPECT_NE(refusal(h + r + std::to_string(n) + "\n").find("f.csv:2: n_points: " + std::to_string(n) + " points fit no "),
+                std::string::npos)
+          << r << n;
+    EXPECT_EQ(refusal(h + r + std::to_string(minimum) + "\n"), "") << r << minimum;
+  }
+  EXPECT_NE(refusal(h + "1,A,plane,0,0,0,0,0,1,,,2\n").find("a plane has 3 parameters, so its fit needs at least 3 points"),
+            std::string::npos);
+}
+
 TEST(FeatureActuals, MatchesForeignIdsByNominalCentreAndRepeatsByTime) {
   const auto m = plan();
   std::string t = kHeader;
