@@ -131,7 +131,7 @@ std::vector<FeatureActual> parseFeatureActuals(const std::string& text, const st
   return out;
 }
 
-std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, int max_cycle) {
+std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, int max_cycle, std::optional<double> known_radius_mm) {
   std::vector<FeatureActual> out;
   for (const auto& c : d.features) {
     FeatureActual f;
@@ -148,12 +148,15 @@ std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, 
       geometry::Points3 p;
       for (const auto& q : c.points) p.push_back(q.p_mm);
       geometry::FitResult fit;
+      geometry::FitOptions options;
+      options.fixed_radius_mm = known_radius_mm;  // the point route's default (docs/uncertainty.md)
       try {
-        fit = geometry::fitElement(geometry::ElementKind::Sphere, p, {}).fit;
+        fit = geometry::fitElement(geometry::ElementKind::Sphere, p, options).fit;
       } catch (const GeometryError& x) {
         throw InputError(d.file, c.line, "sphere '" + c.name + "' (points only): " + x.what());
       }
       f.fitted_here = true;
+      if (known_radius_mm) f.fitted_known_radius_mm = *known_radius_mm;
       f.has_geometry = true;
       f.location_mm = fit.element.position_mm;
       f.size_mm = 2 * fit.element.radius_mm;

@@ -20,6 +20,7 @@
 // silently.
 #pragma once
 #include <Eigen/Dense>
+#include <cmath>
 #include <map>
 #include <optional>
 #include <string>
@@ -45,6 +46,7 @@ struct FeatureActual {
   std::optional<double> time_s;
   bool has_geometry = true;  // false: a QIF/DMIS feature with points but no measured geometry
   bool fitted_here = false;  // a sphere of points only: its centre fitted here (featureActualsFromCmm)
+  double fitted_known_radius_mm = NAN;  // fitted_here with a known radius: that radius; NaN: free radius
   // How the CMM fitted it, as the file states it (QIF SubstituteFeatureAlgorithmEnum names,
   // e.g. LEASTSQUARES, MINMAX; the CSV's optional column `algorithm`); "" not stated.
   std::string algorithm;
@@ -61,11 +63,14 @@ std::vector<FeatureActual> parseFeatureActuals(const std::string& text, const st
 // feature actuals: the cycle is the document's measurement run (QIF: the MeasurementResults in
 // order; DMIS output: 1), the id the feature's name, size and form as the file states them,
 // n_points the points it carries (0: none exported). A sphere without measured geometry but with
-// points (a QIF or DMIS export of points only) gets its centre here: the least-squares sphere of
-// its points (free radius; form = the range of the residuals; fitted_here), as the CMM software
-// would have stated it; with fewer than 4 points, or points that fix no sphere, it is refused with
-// its line. Cycles beyond max_cycle (> 0) are refused.
-std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, int max_cycle = 0);
+// points (a QIF or DMIS export of points only; surface points) gets its centre here: the
+// least-squares sphere of its points (form = the range of the residuals; fitted_here), of the
+// known radius known_radius_mm when given (the point route's default: a free radius is shrunk by
+// the probe's pre-travel and lifts the centre, docs/uncertainty.md; fitted_known_radius_mm says
+// which), else of a free radius; with fewer than 4 points, or points that fix no sphere, it is
+// refused with its line. Cycles beyond max_cycle (> 0) are refused.
+std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, int max_cycle = 0,
+                                                 std::optional<double> known_radius_mm = std::nullopt);
 
 // True when a CSV text's header holds the feature-actuals columns (for --format auto).
 bool looksLikeFeatureActuals(const std::string& text);
