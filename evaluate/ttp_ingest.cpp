@@ -293,8 +293,8 @@ std::string neededBecause(const parts::PlanManifest& m, const parts::ManifestFea
 // the stated geometry (feature_match.hpp) to say which feature it is.
 void statedWithoutPoints(const interop::CmmDocument& d, const parts::PlanManifest& m, const TtpPoints& points,
                          std::vector<InputWarning>& warnings) {
-  interop::CmmDocument stated = d;
-  stated.features.clear();
+  interop::CmmDocument stated;  // those features alone (not a copy of every point)
+  stated.file = d.file;
   std::size_t with_points = 0;
   for (const auto& f : d.features) {
     if (!f.points.empty()) ++with_points;
