@@ -38,6 +38,16 @@ void checkPlausible(const FeatureActual& f) {
 
 }  // namespace
 
+int minimumPoints(const std::string& kind) {
+  // The parameters a least-squares fit determines: a plane's position and normal (3), a
+  // circle's centre in its plane and radius (3), a sphere's centre and radius (4), a cylinder's
+  // axis (4) and radius (5); a point is one point.
+  if (kind == "plane" || kind == "circle") return 3;
+  if (kind == "sphere") return 4;
+  if (kind == "cylinder") return 5;
+  return 1;
+}
+
 bool looksLikeFeatureActuals(const std::string& text) {
   const auto h = csvHeaderFields(text);
   for (const char* c : kRequired)
@@ -98,6 +108,10 @@ std::vector<FeatureActual> parseFeatureActuals(const std::string& text, const st
     const double n = t.number(row, col[11]);
     if (n != std::round(n) || n < 1 || n > 1e9) fail("n_points", row.fields[col[11]] + " is not a positive integer");
     f.n_points = static_cast<int>(n);
+    // Fewer points than the element's parameters fix no element: the row is not a fit.
+    if (f.n_points < minimumPoints(f.kind))
+      fail("n_points", row.fields[col[11]] + " points fit no " + f.kind + ": a " + f.kind + " has " + std::to_string(minimumPoints(f.kind)) +
+                           " parameters, so its fit needs at least " + std::to_string(minimumPoints(f.kind)) + " points");
     const int n_blank = n_u == 3 ? blank(row, cu[0]) + blank(row, cu[1]) + blank(row, cu[2]) : 3;
     if (n_blank != 0 && n_blank != 3) fail("u_x_um,u_y_um,u_z_um", "all three or none (this row's location has no stated u)");
     if (n_blank == 0) {
@@ -117,7 +131,7 @@ std::vector<FeatureActual> parseFeatureActuals(const std::string& text, const st
   return out;
 }
 
-std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, int max_cycle) {
+std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, int max_cycle, std::optional<double> known_radius_mm) {
   std::vector<FeatureActual> out;
   for (const auto& c : d.features) {
     FeatureActual f;
@@ -134,12 +148,15 @@ std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, 
       geometry::Points3 p;
       for (const auto& q : c.points) p.push_back(q.p_mm);
       geometry::FitResult fit;
+      geometry::FitOptions options;
+      options.fixed_radius_mm = known_radius_mm;  // the point route's default (docs/uncertainty.md)
       try {
-        fit = geometry::fitElement(geometry::ElementKind::Sphere, p, {}).fit;
+        fit = geometry::fitElement(geometry::ElementKind::Sphere, p, options).fit;
       } catch (const GeometryError& x) {
         throw InputError(d.file, c.line, "sphere '" + c.name + "' (points only): " + x.what());
       }
       f.fitted_here = true;
+      if (known_radius_mm) f.fitted_known_radius_mm = *known_radius_mm;
       f.has_geometry = true;
       f.location_mm = fit.element.position_mm;
       f.size_mm = 2 * fit.element.radius_mm;

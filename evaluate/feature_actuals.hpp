@@ -9,15 +9,18 @@
 // cylinder, plane or point; x/y/z the centre (sphere, circle), a point on the axis (cylinder)
 // or on the plane; i/j/k the axis or normal (empty or 0 for a sphere or point); size_mm the
 // diameter (empty for a plane or point); form_um the form deviation (empty: not stated);
-// n_points the number of points the CMM fitted (>= 1).
+// n_points the number of points the CMM fitted: at least the element's fitted parameters
+// (minimumPoints: plane 3, circle 3, sphere 4, cylinder 5, point 1).
 //
 // Contract: InputError with file:line:field for a missing column, an unknown kind, a field that
-// is not a number where one is needed, a count that is not a positive integer, a negative
+// is not a number where one is needed, a count that is not a positive integer or is below the
+// kind's minimumPoints (no fit of that kind has so few points), a negative
 // size/form/u, a direction of zero length where one is needed, a coordinate or size beyond 1 km
 // or a form or u beyond 1 m (not a measurement: it would overflow a budget). Nothing is guessed
 // silently.
 #pragma once
 #include <Eigen/Dense>
+#include <cmath>
 #include <map>
 #include <optional>
 #include <string>
@@ -43,10 +46,15 @@ struct FeatureActual {
   std::optional<double> time_s;
   bool has_geometry = true;  // false: a QIF/DMIS feature with points but no measured geometry
   bool fitted_here = false;  // a sphere of points only: its centre fitted here (featureActualsFromCmm)
+  double fitted_known_radius_mm = NAN;  // fitted_here with a known radius: that radius; NaN: free radius
   // How the CMM fitted it, as the file states it (QIF SubstituteFeatureAlgorithmEnum names,
   // e.g. LEASTSQUARES, MINMAX; the CSV's optional column `algorithm`); "" not stated.
   std::string algorithm;
 };
+
+// The fewest points that fix an element of the kind (its least-squares fit's parameters):
+// plane 3, circle 3, sphere 4, cylinder 5; point (and any other) 1.
+int minimumPoints(const std::string& kind);
 
 // max_cycle > 0 refuses a cycle beyond it (the plan's cycles).
 std::vector<FeatureActual> parseFeatureActuals(const std::string& text, const std::string& file, int max_cycle = 0);
@@ -55,11 +63,14 @@ std::vector<FeatureActual> parseFeatureActuals(const std::string& text, const st
 // feature actuals: the cycle is the document's measurement run (QIF: the MeasurementResults in
 // order; DMIS output: 1), the id the feature's name, size and form as the file states them,
 // n_points the points it carries (0: none exported). A sphere without measured geometry but with
-// points (a QIF or DMIS export of points only) gets its centre here: the least-squares sphere of
-// its points (free radius; form = the range of the residuals; fitted_here), as the CMM software
-// would have stated it; with fewer than 4 points, or points that fix no sphere, it is refused with
-// its line. Cycles beyond max_cycle (> 0) are refused.
-std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, int max_cycle = 0);
+// points (a QIF or DMIS export of points only; surface points) gets its centre here: the
+// least-squares sphere of its points (form = the range of the residuals; fitted_here), of the
+// known radius known_radius_mm when given (the point route's default: a free radius is shrunk by
+// the probe's pre-travel and lifts the centre, docs/uncertainty.md; fitted_known_radius_mm says
+// which), else of a free radius; with fewer than 4 points, or points that fix no sphere, it is
+// refused with its line. Cycles beyond max_cycle (> 0) are refused.
+std::vector<FeatureActual> featureActualsFromCmm(const interop::CmmDocument& d, int max_cycle = 0,
+                                                 std::optional<double> known_radius_mm = std::nullopt);
 
 // True when a CSV text's header holds the feature-actuals columns (for --format auto).
 bool looksLikeFeatureActuals(const std::string& text);

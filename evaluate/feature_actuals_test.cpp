@@ -88,6 +88,28 @@ TEST(FeatureActuals, RefusesWithLineAndField) {
             std::string::npos);
 }
 
+// A fit needs at least as many points as its element has parameters: plane 3 (distance, two
+// angles of the normal), circle 3 (centre in its plane, radius), sphere 4 (centre, radius),
+// cylinder 5 (axis: a point in a plane across it and two angles; radius). One fewer is refused
+// with the line and the field; exactly that many is read; a point is one point.
+TEST(FeatureActuals, RefusesFewerPointsThanTheElementsParameters) {
+  const std::string h = "cycle,id,kind,x_mm,y_mm,z_mm,i,j,k,size_mm,form_um,n_points\n";
+  const std::pair<const char*, int> kinds[] = {{"1,A,plane,0,0,0,0,0,1,,,", 3},
+                                               {"1,A,circle,0,0,0,0,0,1,20,,", 3},
+                                               {"1,A,sphere,0,0,0,,,,30,,", 4},
+                                               {"1,A,cylinder,0,0,0,0,0,1,20,,", 5},
+                                               {"1,A,point,0,0,0,,,,,,", 1}};
+  for (const auto& [r, minimum] : kinds) {
+    for (int n = 1; n < minimum; ++n)
+      EXPECT_NE(refusal(h + r + std::to_string(n) + "\n").find("f.csv:2: n_points: " + std::to_string(n) + " points fit no "),
+                std::string::npos)
+          << r << n;
+    EXPECT_EQ(refusal(h + r + std::to_string(minimum) + "\n"), "") << r << minimum;
+  }
+  EXPECT_NE(refusal(h + "1,A,plane,0,0,0,0,0,1,,,2\n").find("a plane has 3 parameters, so its fit needs at least 3 points"),
+            std::string::npos);
+}
+
 TEST(FeatureActuals, MatchesForeignIdsByNominalCentreAndRepeatsByTime) {
   const auto m = plan();
   std::string t = kHeader;
@@ -176,4 +198,43 @@ TEST(FeatureActualsFromCmm, ASphereOfPointsOnlyGetsItsLeastSquaresCentreHere) {
     EXPECT_NE(std::string(e.what()).find("points.qif:12: sphere 'S1' has no measured Location and 3 points"), std::string::npos)
         << e.what();
   }
+}
+
+// Points only on a sphere whose radius the probe's pre-travel shrank (2 um below the known 15 mm),
+// the upper hemisphere as a probe reaches it: the free-radius fit returns the true centre and
+// 14.998 mm; the known-radius fit (the point route's default) keeps 15 mm and moves the centre by
+// the offset that best stretches the points onto 15 mm. That offset, derived by hand: with the
+// centre at c + t, point k (direction u_k) lies at ~ 14.998 - t.u_k (first order), so least
+// squares gives (sum u u^T) t = -0.002 mm sum u. For the six directions below, sum u = (0.6, 0,
+// 1.8) and sum u u^T has xx 2.36, yy 2, zz 1.64, xz 0.48: t_x = -0.002 (1.64 * 0.6 - 0.48 * 1.8)
+// / 3.64, t_z = -0.002 (2.36 * 1.8 - 0.48 * 0.6) / 3.64 mm (3.64 the 2x2 determinant), t_y = 0.
+TEST(FeatureActualsFromCmm, ASphereOfPointsOnlyIsFittedWithTheKnownRadiusUnlessFree) {
+  interop::CmmDocument d;
+  d.file = "points.qif";
+  interop::CmmFeature s;
+  s.name = "S1";
+  s.kind = interop::CmmFeatureKind::Sphere;
+  s.line = 7;
+  const Eigen::Vector3d c(-160, 0, 75);
+  for (const Eigen::Vector3d& u : {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(-1, 0, 0),
+                                   Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, -1, 0), Eigen::Vector3d(0.6, 0, 0.8)}) {
+    interop::CmmPoint p;
+    p.p_mm = c + 14.998 * u;
+    s.points.push_back(p);
+  }
+  d.features.push_back(s);
+  const auto free = featureActualsFromCmm(d);
+  ASSERT_EQ(free.size(), 1u);
+  EXPECT_LT((free[0].location_mm - c).norm(), 1e-9);
+  EXPECT_NEAR(free[0].size_mm, 2 * 14.998, 1e-9);
+  EXPECT_TRUE(std::isnan(free[0].fitted_known_radius_mm));
+  const auto known = featureActualsFromCmm(d, 0, 15.0);
+  ASSERT_EQ(known.size(), 1u);
+  EXPECT_EQ(known[0].fitted_known_radius_mm, 15.0);
+  EXPECT_NEAR(known[0].size_mm, 30.0, 1e-12);
+  const double tx = -0.002 * (1.64 * 0.6 - 0.48 * 1.8) / 3.64, tz = -0.002 * (2.36 * 1.8 - 0.48 * 0.6) / 3.64;
+  EXPECT_NEAR(known[0].location_mm.x(), c.x() + tx, 1e-6);  // first order: (2 um)^2 / 15 mm is below 1e-6 mm
+  EXPECT_NEAR(known[0].location_mm.z(), c.z() + tz, 1e-6);
+  EXPECT_NEAR(known[0].location_mm.y(), c.y(), 1e-9);
+  EXPECT_GT(known[0].form_um, 0.1);  // the misfit of 15 mm on 14.998 mm shows as form
 }

@@ -1,5 +1,6 @@
 #include "evaluate/input_warnings.hpp"
 
+#include <algorithm>
 #include <nlohmann/json.hpp>
 
 namespace probeloop::evaluate {
@@ -33,9 +34,18 @@ std::string withInputWarningsSection(const std::string& report_md, const std::ve
   std::string o = report_md;
   if (!o.empty() && o.back() != '\n') o += "\n";
   o += "\n## Input warnings\n\n";
-  o += "The input file was read leniently (docs/interop.md#lenient-reading): each line names what its producer got wrong "
-       "without changing the meaning, and what was done. `--strict` refuses the file instead.\n\n";
-  for (const auto& w : ws) o += "- `" + w.file + "` line " + std::to_string(w.line) + ": " + w.what + "\n";
+  const bool all_strict = std::all_of(ws.begin(), ws.end(), [](const InputWarning& w) { return w.strict_refuses; });
+  const bool any_strict = std::any_of(ws.begin(), ws.end(), [](const InputWarning& w) { return w.strict_refuses; });
+  if (any_strict)
+    o += "The input file was read leniently (docs/interop.md#lenient-reading): each line names what its producer got wrong "
+         "without changing the meaning, and what was done. `--strict` refuses the file instead.";
+  if (!all_strict)
+    o += std::string(any_strict ? " Lines marked (kept under `--strict`) are" : "Each line names") +
+         " what the file holds and the evaluation does not use (docs/interop.md#lenient-reading): the file's meaning is whole, so "
+         "`--strict` does not refuse it.";
+  o += "\n\n";
+  for (const auto& w : ws)
+    o += "- `" + w.file + "` line " + std::to_string(w.line) + ": " + w.what + (w.strict_refuses || !any_strict ? "" : " (kept under `--strict`)") + "\n";
   return o;
 }
 

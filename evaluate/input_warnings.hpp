@@ -15,6 +15,10 @@ struct InputWarning {
   std::string file;
   int line = 0;
   std::string what;  // what was wrong; what was done
+  // false: not a producer's form mistake but what the evaluation left unused (a feature stated
+  // without points in a file of points, evaluate/ttp_ingest.hpp): --strict keeps it a warning,
+  // and report.md says so.
+  bool strict_refuses = true;
 };
 
 std::vector<InputWarning> inputWarnings(const interop::CmmDocument& d);  // d.file, each warning's line and words

@@ -31,6 +31,29 @@ TEST(InputWarnings, TheKeyComesLastAndTheRestKeepsItsText) {
   EXPECT_EQ(inputWarningLines(ws), "warning: a.qif:7: WholePointSetId: no MeasuredPointSet with id 4; left unassigned\n");
 }
 
+// A warning --strict does not refuse (a feature stated without points in a file of points):
+// report.md must not claim --strict would refuse the file. Alone: its own intro; beside a reader's
+// warning: the reader's intro, and the other line marked.
+TEST(InputWarnings, ASectionSaysWhichWarningsStrictKeeps) {
+  const InputWarning unused{"a.qif", 9, "feature Z3 states its measured geometry but no points", false};
+  const InputWarning lenient{"a.qif", 7, "WholePointSetId: no MeasuredPointSet with id 4; left unassigned"};
+  const std::string alone = withInputWarningsSection("# R\n", {unused});
+  EXPECT_EQ(alone.find("`--strict` refuses the file instead"), std::string::npos) << alone;
+  EXPECT_NE(alone.find("the file's meaning is whole, so `--strict` does not refuse it.\n\n"
+                       "- `a.qif` line 9: feature Z3 states its measured geometry but no points\n"),
+            std::string::npos)
+      << alone;
+  const std::string both = withInputWarningsSection("# R\n", {lenient, unused});
+  EXPECT_NE(both.find("`--strict` refuses the file instead. Lines marked (kept under `--strict`) are what the file holds"),
+            std::string::npos)
+      << both;
+  EXPECT_NE(both.find("- `a.qif` line 7: WholePointSetId: no MeasuredPointSet with id 4; left unassigned\n"), std::string::npos);
+  EXPECT_NE(both.find("- `a.qif` line 9: feature Z3 states its measured geometry but no points (kept under `--strict`)\n"),
+            std::string::npos);
+  // evaluation.json and stdout carry it as any other.
+  EXPECT_EQ(inputWarningLines({unused}), "warning: a.qif:9: feature Z3 states its measured geometry but no points\n");
+}
+
 TEST(InputWarnings, FromADocument) {
   interop::CmmDocument d;
   d.file = "x.dmo";

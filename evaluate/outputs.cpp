@@ -1,4 +1,5 @@
 // Writers of the evaluation outputs (formats: docs/formats.md).
+#include <cmath>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -99,8 +100,11 @@ std::string evaluationJson(const CampaignEvaluation& e, const parts::PlanManifes
         js["feature"] = {{"id", f.id},
                          {"line", f.line},
                          {"matched_by", s.stated->by_id ? "id" : "nearest nominal centre"},
-                         {"centre", f.fitted_here ? "least-squares sphere of the file's points (free radius), fitted here"
-                                                  : "as the file states it"},
+                         {"centre", !f.fitted_here ? "as the file states it"
+                                    : std::isfinite(f.fitted_known_radius_mm)
+                                        ? "least-squares sphere of the file's points (known radius " + formatNumber(f.fitted_known_radius_mm) +
+                                              " mm, the plan's; --free-radius frees it), fitted here"
+                                        : std::string("least-squares sphere of the file's points (free radius, --free-radius), fitted here")},
                          {"diameter_mm", finiteOrNull(f.size_mm)},
                          {"form_um", finiteOrNull(f.form_um)},
                          {"n_points", f.n_points}};

@@ -60,7 +60,10 @@ EvaluationFiles sphere(const parts::PlanManifest& planned, const EvaluateRequest
     // (A DMIS output holds one run: a campaign's cycles cannot be told apart in it; not read yet.)
     const auto doc = interop::parseQifResults(readFile(r.input_file), r.input_file, interop::CmmReadOptions{r.strict});
     warnings = inputWarnings(doc);
-    f.sphere = evaluateSphereCampaignFromFeatures(m, sphereCentresFromFeatures(featureActualsFromCmm(doc, m.cycles), m), r.input_file, opt);
+    // A sphere of points only is fitted as the point route fits it: known radius unless --free-radius.
+    const std::optional<double> radius = r.free_radius ? std::nullopt : std::optional<double>(m.sphere_radius_mm);
+    f.sphere = evaluateSphereCampaignFromFeatures(m, sphereCentresFromFeatures(featureActualsFromCmm(doc, m.cycles, radius), m),
+                                                  r.input_file, opt);
   } else {
     if (r.format != "auto" && r.format != "linuxcnc" && r.format != "fanuc" && r.format != "csv")
       throw InputError("", 0, "--format '" + r.format + "': a sphere-artifact campaign takes auto, linuxcnc, fanuc, csv (points), "

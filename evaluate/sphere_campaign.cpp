@@ -268,7 +268,14 @@ void evaluateLocationErrors(const parts::PlanManifest& m, const Layout& layout, 
 
 CampaignEvaluation evaluateSphereCampaignFromFeatures(const parts::PlanManifest& m, const SphereCentresFromFeatures& centres,
                                                       const std::string& file, const EvaluateOptions& opt) {
-  if (!opt.known_radius) throw InputError(file, 0, "--free-radius: sphere centres read from a feature file come from no fit of ours");
+  // --free-radius chooses how a centre is fitted: only a sphere of points only is fitted here
+  // (featureActualsFromCmm); a stated centre comes from no fit of ours.
+  if (!opt.known_radius)
+    for (const auto& [cycle, by_position] : centres.by_cycle)
+      for (const auto& [position, c] : by_position)
+        if (!c.feature.fitted_here)
+          throw InputError(c.feature.file, c.feature.line, "--free-radius: sphere '" + c.feature.id +
+                                                               "' states its centre, which comes from no fit of ours");
   CampaignEvaluation out;
   out.manifest_file = m.file;
   out.points_file = file;
@@ -324,7 +331,10 @@ CampaignEvaluation evaluateSphereCampaignFromFeatures(const parts::PlanManifest&
     ce.time_s = t_sum / n_sum;
     out.cycles.push_back(std::move(ce));
   }
-  evaluateLocationErrors(m, layout, out, opt);
+  // The centres are the file's or fitted here as --free-radius chose: no free-radius fit to switch to.
+  EvaluateOptions stated = opt;
+  stated.known_radius = true;
+  evaluateLocationErrors(m, layout, out, stated);
   return out;
 }
 

@@ -109,7 +109,9 @@ CampaignEvaluation evaluateSphereCampaign(const parts::PlanManifest& manifest,
 // states (location_budget.hpp FeatureCentreU). A position without a centre makes its cycle
 // incomplete, listed as the point route lists a position without points. The time of a centre
 // is its time_s, else the mean planned time of its position's points; the cycle's, their mean
-// weighted by n_points. --free-radius does not apply (there is no fit).
+// weighted by n_points. --free-radius (options.known_radius false) chose how the centres of a
+// file of points only were fitted (featureActualsFromCmm); with a centre the file states (no fit
+// of ours) it is refused, naming the row's line.
 CampaignEvaluation evaluateSphereCampaignFromFeatures(const parts::PlanManifest& manifest, const SphereCentresFromFeatures& centres,
                                                       const std::string& file, const EvaluateOptions& options = {});
 

@@ -12,6 +12,7 @@
 #include "core/input_file.hpp"
 #include "core/error.hpp"
 #include "evaluate/feature_actuals.hpp"
+#include "evaluate/feature_match.hpp"
 #include "interop/dmis.hpp"
 #include "interop/qif.hpp"
 #include "core/units.hpp"
@@ -269,6 +270,72 @@ TtpPoints cmmPointsFromRows(const std::string& path, const std::string& format, 
   return out;
 }
 
+// Why the piece's evaluation cannot do without a feature's points ("" when it can: the values
+// that use it are listed as not evaluated). The thermal test piece: its datums (the part frame)
+// and its reference features (cycle 0: every value of a side is measured against them); the
+// stepped workpiece: every planned plane.
+std::string neededBecause(const parts::PlanManifest& m, const parts::ManifestFeature& f) {
+  const std::string& id = f.nominal.id;
+  if (m.pieceKind() == parts::PieceKind::SteppedWorkpiece)
+    return "the stepped workpiece's evaluation needs the points of every planned plane, " + id + "'s too";
+  if (m.pieceKind() != parts::PieceKind::ThermalTestPiece) return "";
+  if (f.nominal.role.rfind("datum", 0) == 0) return "the datum " + id + " needs its points (seed 004 L2055: the part frame)";
+  if (f.cycle == 0)
+    return "the reference feature " + id + " (cycle 0) needs its points: every value of its side is measured against it";
+  return "";
+}
+
+// A feature a QIF/DMIS file states with its measured geometry but without points, in a file whose
+// other features carry points (issue 34): the point route fits its own features, so it is not used.
+// Said as a warning with its line; refused, with its line and the reason, when the evaluation
+// needs that feature's points and the file gives none for it. Not a producer's form mistake (the
+// file's meaning is whole): --strict keeps it a warning. Foreign names are matched to the plan by
+// the stated geometry (feature_match.hpp) to say which feature it is.
+void statedWithoutPoints(const interop::CmmDocument& d, const parts::PlanManifest& m, const TtpPoints& points,
+                         std::vector<InputWarning>& warnings) {
+  interop::CmmDocument stated;  // those features alone (not a copy of every point)
+  stated.file = d.file;
+  std::size_t with_points = 0;
+  for (const auto& f : d.features) {
+    if (!f.points.empty()) ++with_points;
+    else if (f.measured.given) stated.features.push_back(f);
+  }
+  if (stated.features.empty()) return;
+  std::vector<FeatureActual> rows;
+  try {
+    rows = featureActualsFromCmm(stated);
+  } catch (const InputError&) {
+    // Not plausible as stated: named by the file's names alone below.
+  }
+  std::map<int, std::string> manifest_id;  // by line: the plan's feature it states
+  for (const auto& f : stated.features)
+    if (m.feature(f.name)) manifest_id[f.line] = f.name;
+  if (manifest_id.size() < stated.features.size() && !rows.empty()) {
+    try {
+      for (const auto& x : matchFeatureActuals(rows, m).matched)
+        if (!x.by_id) manifest_id[x.actual.line] = x.feature->nominal.id;
+    } catch (const InputError&) {
+      // Not matched (another frame, ambiguous): named by the file's names alone.
+    }
+  }
+  std::set<std::string> measured;
+  for (const auto& p : points.points) measured.insert(p.feature);
+  const std::string others = std::to_string(with_points) + (with_points == 1 ? " feature" : " features") + " of the file carry points";
+  const std::string route = "the point route fits its own features from the points (a file of features only is evaluated from "
+                            "them, docs/formats.md#evaluating-from-features)";
+  for (const auto& f : stated.features) {
+    const auto it = manifest_id.find(f.line);
+    const std::string id = it == manifest_id.end() ? "" : it->second;
+    const std::string name = "feature " + f.name + (id.empty() || id == f.name ? "" : " (" + id + " by its nominal geometry)");
+    const std::string what = name + " states its measured geometry but no points, while " + others;
+    const auto* mf = id.empty() ? nullptr : m.feature(id);
+    const std::string need = mf && !measured.count(id) ? neededBecause(m, *mf) : "";
+    if (!need.empty())
+      throw InputError(d.file, f.line, what + ": " + need + ", and " + route + ": export " + f.name + "'s points, or no feature's");
+    warnings.push_back({d.file, f.line, what + ": not used; " + route, false});
+  }
+}
+
 // A QIF 3.0 Results document or a DMIS output file: every measured feature's points, labelled
 // by its name, numbered in their order (the line: the feature measurement's).
 TtpPoints cmmResults(const std::string& path, const std::string& text, const parts::PlanManifest& m, bool qif, bool strict) {
@@ -288,6 +355,7 @@ TtpPoints cmmResults(const std::string& path, const std::string& text, const par
                                   " measured features: the evaluation fits its own planes and needs the points");
   auto out = cmmPointsFromRows(path, qif ? "qif" : "dmis", rows, true, m);
   out.warnings = inputWarnings(d);
+  statedWithoutPoints(d, m, out, out.warnings);
   return out;
 }
 

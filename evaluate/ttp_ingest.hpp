@@ -67,7 +67,11 @@ struct TtpGaugeReadings {
 std::string detectTtpFormat(const std::string& path, const std::string& text);
 
 // QIF and DMIS exports are read leniently (docs/interop.md#lenient-reading): the reader's
-// warnings land in TtpPoints::warnings (file, line, what); strict refuses them instead.
+// warnings land in TtpPoints::warnings (file, line, what); strict refuses them instead. A feature
+// such a file states with its measured geometry but without points, beside features with points,
+// is not used: a warning with its line (strict_refuses false: --strict keeps it), or an
+// InputError at that line naming it and why when the piece's evaluation needs its points (the
+// thermal test piece's datums and cycle-0 reference features; every stepped-workpiece plane).
 TtpPoints readTtpCmmExport(const std::string& path, const std::string& text, const parts::PlanManifest& m, bool strict = false);
 // format: csv (the points CSV) or linuxcnc | fanuc | log (a PT log).
 TtpPoints readTtpOnMachine(const std::string& path, const std::string& text, const std::string& format,

@@ -16,6 +16,9 @@
 - the reader's warnings (issue 34 item 4): a vendor extension in the thermal test piece's QIF and
   a statement after ENDFIL in W8's DMIS output reach stdout, evaluation.json's input_warnings
   and report.md's section (none in the clean files'), the same errors.csv; --strict refuses them;
+- a feature stated with its geometry but without points in a QIF of points (issue 34): Z3 warned
+  with its line in every output (kept under --strict), its cycle's values not evaluated and the
+  others unchanged; the datum CYL without points refused naming it, its line and why;
 - bad input: a QIF file of another version, a point set whose count does not match its points,
   a DMIS output with a feature we did not plan, and a DMIS program whose move goes through the
   part are refused naming the file, the line and the field, and nothing is written.
@@ -122,6 +125,44 @@ if code == 0:
         c5, _, e5 = run("evaluate", f"{W}/vendor.qif", "--manifest", f"{T}/plan/plan.json", "--out", f"{T}/ev-strict", "--strict")
         check("evaluate --strict: refused at that line, nothing written", c5 != 0 and f"vendor.qif:{ext_line}: MeasurementResults: unknown "
               "extension Probe" in e5 and not os.path.exists(f"{T}/ev-strict/errors.csv"), e5)
+        # A feature stated with its geometry but without points, in a file of points (issue 34): the
+        # point route fits its own features, so it is not used, said as a warning with its line
+        # (kept under --strict: the file's meaning is whole); a datum without points is refused,
+        # naming it, its line and why.
+        def without_points(text, name):
+            """The QIF with feature `name`'s point set removed; the line of its FeatureMeasurement."""
+            item = re.search(r'<\w+FeatureItem id="(\d+)">\s*(?:<FeatureNominalId>\d+</FeatureNominalId>\s*)?'
+                             rf'<FeatureName>{name}</FeatureName>', text).group(1)
+            m = re.search(r'(<\w+FeatureMeasurement id="\d+">\s*<FeatureItemId>' + item + r'</FeatureItemId>)'
+                          r'\s*<PointList n="1">\s*<WholePointSetId>(\d+)</WholePointSetId>\s*</PointList>', text)
+            text = text[:m.start()] + m.group(1) + text[m.end():]
+            text = re.sub(rf'\s*<MeasuredPointSet id="{m.group(2)}".*?</MeasuredPointSet>', "", text, flags=re.S)
+            n = text.count("<MeasuredPointSet id=")
+            return re.sub(r'<MeasuredPointSets n="\d+">', f'<MeasuredPointSets n="{n}">', text), text[:m.start()].count("\n") + 1
+        because = ("the point route fits its own features from the points (a file of features only is evaluated from them, "
+                   "docs/formats.md#evaluating-from-features)")
+        z3, z3_line = without_points(qif, "Z3")
+        open(f"{W}/no_z3.qif", "w").write(z3)
+        c8, out8, e8 = run("evaluate", f"{W}/no_z3.qif", "--manifest", f"{T}/plan/plan.json", "--out", f"{T}/ev-no-z3", "--strict")
+        what = f"feature Z3 states its measured geometry but no points, while 48 features of the file carry points: not used; {because}"
+        ev8 = json.load(open(f"{T}/ev-no-z3/evaluation.json")) if c8 == 0 else {}
+        r8 = open(f"{T}/ev-no-z3/report.md").read() if c8 == 0 else ""
+        check(f"Z3 stated without points: warned at its line {z3_line} in stdout, evaluation.json and report.md, kept under "
+              "--strict", c8 == 0 and f"warning: {W}/no_z3.qif:{z3_line}: {what}\n" in out8
+              and ev8.get("input_warnings") == [{"file": f"{W}/no_z3.qif", "line": z3_line, "what": what}]
+              and f"- `{W}/no_z3.qif` line {z3_line}: {what}\n" in r8 and "`--strict` does not refuse it" in r8, out8[-600:] + e8)
+        # (Their U moves a little: the pooled type A scatter has Z3's points fewer.)
+        b8 = [l.split(",")[:7] for l in numbers(f"{T}/ev-no-z3/errors.csv")] if c8 == 0 else []
+        check("Z3 stated without points: its cycle's EZ, EB not evaluated (said), the other cycles' errors the point route's, "
+              "every printed digit", "Cycle 3: EZ_um, EB_urad not evaluated: Z3 (cycle 3) has no points" in out8
+              and b8 == [l.split(",")[:7] for l in a if l.split(",")[1] != "3"], b8[:3])
+        cyl, cyl_line = without_points(qif, "CYL")
+        open(f"{W}/no_cyl.qif", "w").write(cyl)
+        c9, _, e9 = run("evaluate", f"{W}/no_cyl.qif", "--manifest", f"{T}/plan/plan.json", "--out", f"{T}/ev-no-cyl")
+        check(f"the datum CYL stated without points: refused at its line {cyl_line}, naming it and why, nothing written",
+              c9 != 0 and f"no_cyl.qif:{cyl_line}: feature CYL states its measured geometry but no points, while 48 features of the "
+              f"file carry points: the datum CYL needs its points (seed 004 L2055: the part frame), and {because}: export CYL's "
+              "points, or no feature's" in e9 and not os.path.exists(f"{T}/ev-no-cyl/errors.csv"), e9)
         # The evaluation's own results.qif: valid, and its characteristics are errors.csv's values.
         ok, e = valid(f"{T}/ev-qif/results.qif")
         check("the evaluation's results.qif validates against the QIF 3.0 XSD", ok, e)

@@ -13,7 +13,9 @@ that evaluation.json:
   sqrt(U_points^2 + U_features^2), and the largest difference per error is printed in units of it;
 - a QIF 3.0 Results file with only MeasuredFeatures (one MeasurementResults per cycle, the
   point route's centres): the same errors; the same from points only (25 per sphere, exactly
-  on a sphere about each centre: fitted here); a sphere with neither refused; with a vendor's
+  on a sphere about each centre: fitted here, with the known radius by default); on a 14.998 mm
+  sphere (a 2 um pre-travel) --free-radius gives the same errors and the known radius moves each
+  centre 3 um down, within the combined U; a sphere with neither refused; with a vendor's
   extension, the reader's warning in stdout, evaluation.json's input_warnings and report.md
   (issue 34 item 4), none in the clean file's outputs, and --strict refusing it;
 - refusals with the file and line: an unknown kind, a missing column, two foreign rows on one
@@ -202,7 +204,7 @@ try:
           code == 1 and f"{q}:7:" in err and "sphere 'S2' has no measured Location and 0 points" in err, err)
 
     # --- QIF 3.0 points only (issue 34 item 2): each sphere's centre fitted here to its points ---
-    def qif_points(ev):
+    def qif_points(ev, radius=15.0):
         out = ['<?xml version="1.0" encoding="UTF-8"?>',
                '<QIFDocument xmlns="http://qifstandards.org/xsd/qif3" versionQIF="3.0.0" idMax="99999">',
                f'  <Results><MeasurementResultsSet n="{len(ev["cycles"])}">']
@@ -214,10 +216,11 @@ try:
                 i += 2
                 cx, cy, cz = s["centre_mm"]
                 pts = []
-                for k in range(25):  # a spiral over the upper hemisphere, exactly on a 15 mm sphere
+                for k in range(25):  # a spiral over the upper hemisphere, exactly on a sphere of the radius
                     t = math.acos(1 - (k + 0.5) / 25)
                     a = 2.399963 * k
-                    pts += [cx + 15 * math.sin(t) * math.cos(a), cy + 15 * math.sin(t) * math.sin(a), cz + 15 * math.cos(t)]
+                    pts += [cx + radius * math.sin(t) * math.cos(a), cy + radius * math.sin(t) * math.sin(a),
+                            cz + radius * math.cos(t)]
                 feats.append(f'<SphereFeatureMeasurement id="{i}"><FeatureName>S{s["position"]}</FeatureName><PointList n="1">'
                              f'<WholePointSetId>{i + 1}</WholePointSetId></PointList></SphereFeatureMeasurement>')
                 sets.append(f'<MeasuredPointSet id="{i + 1}" count="25"><Points>{" ".join(repr(v) for v in pts)}</Points>'
@@ -237,6 +240,47 @@ try:
           max(abs(bqp[c][j]["value"] - bp[c][j]["value"]) for c in bp for j in range(7)) <= 1e-9 and
           all(s["feature"]["centre"].startswith("least-squares sphere of the file's points") and s["feature"]["n_points"] == 25
               for c in ev_qp["cycles"] for s in c["spheres"]), err)
+
+    check("QIF points only, by default: the known radius (the plan's 15 mm), said in feature.centre",
+          code == 0 and all("(known radius 15 mm, the plan's; --free-radius frees it)" in s["feature"]["centre"]
+                            for c in ev_qp["cycles"] for s in c["spheres"]), err)
+
+    # Points on a 14.998 mm sphere (a 2 um pre-travel shrinks what the probe sees) about the point
+    # route's centres: --free-radius returns those centres, so the same errors to 1e-9; the known
+    # radius (default, as on the point route) stretches the points onto 15 mm and moves each centre
+    # away from the cap, down by t = 2 um <cos th> / <cos^2 th> (least squares of 2 um - t cos th_k,
+    # first order): 3 um for points spread evenly in cos th over the hemisphere (<cos> = 1/2,
+    # <cos^2> = 1/3). The same shift in every cycle: every error within the combined U.
+    q2 = write("points_pretravel.qif", qif_points(ev_p, 14.998))
+    code, out, err = run("evaluate", q2, "--format", "qif", "--free-radius", "--manifest", PLAN, "--out", f"{W}/qifpts_free")
+    ev_free = json.load(open(f"{W}/qifpts_free/evaluation.json")) if code == 0 else {"cycles": []}
+    bfree = budgets(ev_free)
+    check("QIF points on 14.998 mm, --free-radius: the point route's errors to 1e-9, feature.centre says free radius",
+          code == 0 and sorted(bfree) == sorted(bp) and
+          max(abs(bfree[c][j]["value"] - bp[c][j]["value"]) for c in bp for j in range(7)) <= 1e-9 and
+          all("(free radius, --free-radius)" in s["feature"]["centre"] and abs(s["feature"]["diameter_mm"] - 29.996) < 1e-9
+              for c in ev_free["cycles"] for s in c["spheres"]), err)
+    code, out, err = run("evaluate", q2, "--format", "qif", "--manifest", PLAN, "--out", f"{W}/qifpts_known")
+    ev_known = json.load(open(f"{W}/qifpts_known/evaluation.json")) if code == 0 else {"cycles": []}
+    bknown = budgets(ev_known)
+    dz = [s["centre_mm"][2] - p["centre_mm"][2] for c, cp in zip(ev_known["cycles"], ev_p["cycles"])
+          for s, p in zip(c["spheres"], cp["spheres"])]
+    print(f"     QIF points on 14.998 mm, known radius: centre z - point route's {min(dz) * 1e3:.3f} ... {max(dz) * 1e3:.3f} um")
+    check("QIF points on 14.998 mm, known radius (default): each centre 3 um down (+-0.05 um), feature.centre says known radius",
+          code == 0 and dz and all(abs(d + 3e-3) < 5e-5 for d in dz) and
+          all("(known radius 15 mm" in s["feature"]["centre"] and s["feature"]["diameter_mm"] == 30
+              for c in ev_known["cycles"] for s in c["spheres"]), err)
+    for name, b in (("--free-radius", bfree), ("known radius", bknown)):
+        # (The reference cycle's errors are 0 with U 0 on both routes.)
+        ratio = max((abs(b[c][j]["value"] - bp[c][j]["value"]) / math.hypot(b[c][j]["U"], bp[c][j]["U"])
+                     for c in bp for j in range(7) if c in b and math.hypot(b[c][j]["U"], bp[c][j]["U"]) > 0),
+                    default=float("inf"))
+        print(f"     QIF points on 14.998 mm, {name}: largest |features - points| / combined U {ratio:.4f}")
+        check(f"QIF points on 14.998 mm, {name}: every error within the combined U", ratio <= 1, ratio)
+
+    code, out, err = run("evaluate", same, "--format", "features", "--free-radius", "--manifest", PLAN, "--out", f"{W}/same_free")
+    check("refused: --free-radius for centres a file states (no fit of ours), with the row's line",
+          code == 1 and f"{same}:2: --free-radius: sphere 'S1' states its centre, which comes from no fit of ours" in err, err)
 
     code, out, err = run("evaluate", q, "--format", "dmis", "--manifest", PLAN, "--out", f"{W}/dmis")
     check("refused: --format dmis for a sphere artifact (a DMIS output is one run), naming what it takes",
