@@ -105,11 +105,13 @@ std::vector<FeatureActual> parseFeatureActuals(const std::string& text, const st
       f.form_um = t.number(row, col[10]);
       if (f.form_um < 0) fail("form_um", row.fields[col[10]] + " is negative");
     }
-    const double n = t.number(row, col[11]);
-    if (n != std::round(n) || n < 1 || n > 1e9) fail("n_points", row.fields[col[11]] + " is not a positive integer");
+    // Empty: not stated (0), as a QIF feature without its points; the planned count stands in.
+    const double n = blank(row, col[11]) ? 0.0 : t.number(row, col[11]);
+    if (n != std::round(n) || n < 0 || n > 1e9 || (n == 0 && !blank(row, col[11])))
+      fail("n_points", row.fields[col[11]] + " is not a positive integer (leave it empty when the report does not state it)");
     f.n_points = static_cast<int>(n);
     // Fewer points than the element's parameters fix no element: the row is not a fit.
-    if (f.n_points < minimumPoints(f.kind))
+    if (f.n_points > 0 && f.n_points < minimumPoints(f.kind))
       fail("n_points", row.fields[col[11]] + " points fit no " + f.kind + ": a " + f.kind + " has " + std::to_string(minimumPoints(f.kind)) +
                            " parameters, so its fit needs at least " + std::to_string(minimumPoints(f.kind)) + " points");
     const int n_blank = n_u == 3 ? blank(row, cu[0]) + blank(row, cu[1]) + blank(row, cu[2]) : 3;

@@ -10,7 +10,7 @@
 // or on the plane; i/j/k the axis or normal (empty or 0 for a sphere or point); size_mm the
 // diameter (empty for a plane or point); form_um the form deviation (empty: not stated);
 // n_points the number of points the CMM fitted: at least the element's fitted parameters
-// (minimumPoints: plane 3, circle 3, sphere 4, cylinder 5, point 1).
+// (minimumPoints: plane 3, circle 3, sphere 4, cylinder 5, point 1), empty when not stated (0).
 //
 // Contract: InputError with file:line:field for a missing column, an unknown kind, a field that
 // is not a number where one is needed, a count that is not a positive integer or is below the

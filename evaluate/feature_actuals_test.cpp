@@ -238,3 +238,12 @@ TEST(FeatureActualsFromCmm, ASphereOfPointsOnlyIsFittedWithTheKnownRadiusUnlessF
   EXPECT_NEAR(known[0].location_mm.y(), c.y(), 1e-9);
   EXPECT_GT(known[0].form_um, 0.1);  // the misfit of 15 mm on 14.998 mm shows as form
 }
+
+TEST(ParseFeatureActuals, AnEmptyPointCountIsNotStatedAZeroIsRefused) {
+  const std::string h = "cycle,id,kind,x_mm,y_mm,z_mm,i,j,k,size_mm,form_um,n_points\n";
+  const auto rows = parseFeatureActuals(h + "1,P,plane,0,0,0,0,0,1,,2.5,\n", "f.csv");
+  ASSERT_EQ(rows.size(), 1u);
+  EXPECT_EQ(rows[0].n_points, 0);  // not stated: the plan's count stands in
+  EXPECT_NE(refusal(h + "1,P,plane,0,0,0,0,0,1,,2.5,0\n").find("f.csv:2: n_points: 0 is not a positive integer (leave it empty"),
+            std::string::npos);
+}
