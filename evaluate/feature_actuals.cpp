@@ -274,8 +274,13 @@ SphereCentresFromFeatures sphereCentresFromFeatures(const std::vector<FeatureAct
                                            ": name it by its id");
     foreign[f.cycle][near[0]].push_back(&f);
   }
-  for (auto& [cycle, by_place] : foreign)
-    for (auto& [p, fs] : by_place) {
+  // Not structured bindings: the lambda below uses fs, which clang before 16 cannot capture
+  // (C++20 P1091; scripts/fuzz.sh builds with clang 14).
+  for (auto& cycle_entry : foreign)
+    for (auto& place_entry : cycle_entry.second) {
+      const int cycle = cycle_entry.first;
+      const std::size_t p = place_entry.first;
+      auto& fs = place_entry.second;
       std::vector<int> free;
       for (int pos : places[p])
         if (!out.by_cycle[cycle].count(pos)) free.push_back(pos);

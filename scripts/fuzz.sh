@@ -47,7 +47,7 @@ dict_of() {
   case "$1" in
     ply) echo ply;;
     xyz|nist_ds) echo points;;
-    fit_csv|points_csv|inputs_errors_csv|ttp_cmm_csv) echo csv;;
+    fit_csv|points_csv|inputs_errors_csv|ttp_cmm_csv|feature_actuals) echo csv;;
     probe_log|ttp_on_machine) echo probe_log;;
     verify_linuxcnc) echo gcode_linuxcnc;;
     *_yaml) echo yaml;;
