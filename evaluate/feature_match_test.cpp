@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "core/error.hpp"
+#include "evaluate/feature_test_support.hpp"
 
 using namespace probeloop;
 using namespace probeloop::evaluate;
@@ -14,15 +15,7 @@ namespace {
 
 parts::ManifestFeature plane(const std::string& id, const Eigen::Vector3d& p, const Eigen::Vector3d& n, const Eigen::Vector3d& u,
                              double hu, double hv) {
-  parts::ManifestFeature f;
-  f.nominal.id = id;
-  f.nominal.kind = "plane";
-  f.nominal.point_mm = p;
-  f.nominal.direction = n;
-  f.nominal.u = u;
-  f.nominal.half_u_mm = hu;
-  f.nominal.half_v_mm = hv;
-  return f;
+  return feature_test::nominalPlane(id, p, n, u, hu, hv);
 }
 
 parts::PlanManifest plan() {
@@ -44,16 +37,7 @@ parts::PlanManifest plan() {
 
 FeatureActual row(int line, const std::string& id, const std::string& kind, const Eigen::Vector3d& p, const Eigen::Vector3d& n,
                   double size = NAN) {
-  FeatureActual f;
-  f.file = "f.csv";
-  f.line = line;
-  f.cycle = 1;
-  f.id = id;
-  f.kind = kind;
-  f.location_mm = p;
-  f.direction = n;
-  f.size_mm = size;
-  return f;
+  return feature_test::statedFeature(line, id, kind, p, n, size);
 }
 
 std::string refusal(const std::vector<FeatureActual>& rows) {

@@ -9,6 +9,7 @@
 #include <random>
 
 #include "core/error.hpp"
+#include "evaluate/feature_test_support.hpp"
 #include "geometry/fit.hpp"
 
 using namespace probeloop;
@@ -74,18 +75,7 @@ parts::PlanManifest plan() {
 
 FeatureActual row(int line, const std::string& id, const std::string& kind, const Eigen::Vector3d& p, const Eigen::Vector3d& n,
                   double size, double form_um, int n_points) {
-  FeatureActual f;
-  f.file = "f.csv";
-  f.line = line;
-  f.cycle = 1;
-  f.id = id;
-  f.kind = kind;
-  f.location_mm = p;
-  f.direction = n.normalized();
-  f.size_mm = size;
-  f.form_um = form_um;
-  f.n_points = n_points;
-  return f;
+  return feature_test::statedFeature(line, id, kind, p, n, size, form_um, n_points);
 }
 
 }  // namespace

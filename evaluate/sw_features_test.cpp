@@ -19,17 +19,7 @@ using Eigen::Vector3d;
 using namespace sw_test;
 
 FeatureActual plane(int line, const std::string& id, const Vector3d& p, const Vector3d& n) {
-  FeatureActual f;
-  f.file = "f.csv";
-  f.line = line;
-  f.cycle = 1;
-  f.id = id;
-  f.kind = "plane";
-  f.location_mm = p;
-  f.direction = n.normalized();
-  f.size_mm = NAN;
-  f.form_um = NAN;
-  return f;
+  return feature_test::statedFeature(line, id, "plane", p, n);
 }
 
 // The planes of Surfaces s (sw_test_support.hpp's pointsOn), as a CMM would state them; ids

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "evaluate/ttp_ingest.hpp"
+#include "evaluate/feature_test_support.hpp"
 #include "parts/plan_manifest.hpp"
 
 namespace probeloop::evaluate::sw_test {
@@ -14,16 +15,7 @@ namespace probeloop::evaluate::sw_test {
 using Eigen::Vector3d;
 
 inline parts::ManifestFeature feature(const std::string& id, const std::string& role, Vector3d p, Vector3d n, Vector3d u) {
-  parts::ManifestFeature f;
-  f.nominal.id = id;
-  f.nominal.kind = "plane";
-  f.nominal.role = role;
-  f.nominal.point_mm = p;
-  f.nominal.direction = n;
-  f.nominal.u = u;
-  f.nominal.half_u_mm = 10;
-  f.nominal.half_v_mm = 4;
-  return f;
+  return feature_test::nominalPlane(id, p, n, u, 10, 4, role);
 }
 
 // Two steps, 30 and 45 mm square, floors 9 and 19 mm deep, centred on (15, 15).

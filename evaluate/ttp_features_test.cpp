@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "core/error.hpp"
+#include "evaluate/feature_test_support.hpp"
 #include "evaluate/feature_points.hpp"
 #include "evaluate/thermal_test_piece.hpp"
 #include "evaluate/ttp_ingest.hpp"
@@ -22,18 +23,7 @@ using Eigen::Vector3d;
 
 FeatureActual stated(int line, const std::string& id, const std::string& kind, const Vector3d& p, const Vector3d& n, double size,
                      double form_um, int n_points) {
-  FeatureActual f;
-  f.file = "features.csv";
-  f.line = line;
-  f.cycle = 1;
-  f.id = id;
-  f.kind = kind;
-  f.location_mm = p;
-  f.direction = n.normalized();
-  f.size_mm = size;
-  f.form_um = form_um;
-  f.n_points = n_points;
-  return f;
+  return feature_test::statedFeature(line, id, kind, p, n, size, form_um, n_points, "features.csv");
 }
 
 // The features as the chosen truth makes them, written down from its definition (not fitted):
